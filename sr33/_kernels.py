@@ -1,0 +1,230 @@
+"""Numba kernels of the reconstruction: arrays and scalars in, arrays out.
+
+Every kernel here only computes; validation, contiguity and tie rules live in
+the public function that calls it.  Each kernel has a slow reference in
+``tests/naive.py`` and a property test comparing the two.  No ``fastmath``:
+distance comparisons must be exact IEEE arithmetic so that ties are decided
+by the documented tolerance and nothing else.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _sqdist(p, a, b):
+    dx = p[a, 0] - p[b, 0]
+    dy = p[a, 1] - p[b, 1]
+    dz = p[a, 2] - p[b, 2]
+    return dx * dx + dy * dy + dz * dz
+
+
+@njit(cache=True)
+def local_rng_pairs(points, nb_indptr, nb_indices, shrink2, u_start, u_stop):
+    """Union over all neighbourhoods of the neighbourhood's RNG edges.
+
+    ``nb_indices[nb_indptr[u]:nb_indptr[u+1]]`` is N(u;k) including ``u``.
+    A pair (a, b) of a neighbourhood is an edge unless some c of the same
+    neighbourhood lies strictly inside the lune:
+    ``max(|ac|², |bc|²) < shrink2 · |ab|²`` with ``shrink2 = (1 - rtol)²``.
+    Only neighbourhoods ``u_start <= u < u_stop`` are processed (the caller
+    chunks the work to drive a progress bar).  Returns an (m, 2) int64 array
+    of pairs (a < b), possibly repeated.
+    """
+    cap = 1024
+    out = np.empty((cap, 2), dtype=np.int64)
+    m = 0
+    for u in range(u_start, u_stop):
+        lo = nb_indptr[u]
+        hi = nb_indptr[u + 1]
+        s = hi - lo
+        ids = nb_indices[lo:hi]
+        d2 = np.empty((s, s), dtype=np.float64)
+        for i in range(s):
+            d2[i, i] = 0.0
+            for j in range(i + 1, s):
+                v = _sqdist(points, ids[i], ids[j])
+                d2[i, j] = v
+                d2[j, i] = v
+        for i in range(s):
+            for j in range(i + 1, s):
+                lim = shrink2 * d2[i, j]
+                blocked = False
+                for c in range(s):
+                    if c == i or c == j:
+                        continue
+                    if d2[i, c] < lim and d2[j, c] < lim:
+                        blocked = True
+                        break
+                if not blocked:
+                    if m == cap:
+                        cap *= 2
+                        tmp = np.empty((cap, 2), dtype=np.int64)
+                        tmp[:m] = out[:m]
+                        out = tmp
+                    a = ids[i]
+                    b = ids[j]
+                    if a < b:
+                        out[m, 0] = a
+                        out[m, 1] = b
+                    else:
+                        out[m, 0] = b
+                        out[m, 1] = a
+                    m += 1
+    return out[:m]
+
+
+@njit(cache=True)
+def _bfs_bounded(indptr, indices, src, depth, dist, queue):
+    """Breadth-first distances from ``src`` up to ``depth`` hops.
+
+    ``dist`` must be all -1 on entry; the visited vertices are left in
+    ``queue[:count]`` so the caller can reset them.  Returns ``count``.
+    """
+    dist[src] = 0
+    queue[0] = src
+    head = 0
+    tail = 1
+    while head < tail:
+        x = queue[head]
+        head += 1
+        dx = dist[x]
+        if dx == depth:
+            continue
+        for e in range(indptr[x], indptr[x + 1]):
+            y = indices[e]
+            if dist[y] < 0:
+                dist[y] = dx + 1
+                queue[tail] = y
+                tail += 1
+    return tail
+
+
+@njit(cache=True)
+def _is_isometric(indptr, indices, cyc, L, dist, queue):
+    half = L // 2
+    for i in range(L):
+        cnt = _bfs_bounded(indptr, indices, cyc[i], half, dist, queue)
+        ok = True
+        for j in range(L):
+            dj = j - i
+            if dj < 0:
+                dj = -dj
+            want = min(dj, L - dj)
+            if dist[cyc[j]] != want:
+                ok = False
+                break
+        for q in range(cnt):
+            dist[queue[q]] = -1
+        if not ok:
+            return False
+    return True
+
+
+@njit(cache=True)
+def isometric_cycles(indptr, indices, max_len):
+    """All isometric cycles of length 3..max_len of an undirected graph.
+
+    The graph is CSR with sorted, symmetric adjacency.  A cycle is reported
+    once, starting at its smallest vertex and oriented so that its second
+    vertex is smaller than its last.  The search from start ``s`` follows the
+    characterisation of an isometric cycle seen from one of its vertices: the
+    hop distance from ``s`` rises by one per step, may stay level once (odd
+    length), then falls by one per step back to ``s``; every candidate is
+    then checked pairwise.  Returns ``(offsets, vertices)``.
+    """
+    n = indptr.shape[0] - 1
+    half = max_len // 2
+    dist0 = -np.ones(n, dtype=np.int64)
+    dist = -np.ones(n, dtype=np.int64)
+    queue = np.empty(n, dtype=np.int64)
+    path = np.empty(max_len + 1, dtype=np.int64)
+    it = np.empty(max_len + 1, dtype=np.int64)
+    onpath = np.zeros(n, dtype=np.bool_)
+    cap_c = 1024
+    cap_v = 4096
+    offs = np.empty(cap_c + 1, dtype=np.int64)
+    verts = np.empty(cap_v, dtype=np.int64)
+    offs[0] = 0
+    nc = 0
+    for s in range(n):
+        cnt0 = _bfs_bounded(indptr, indices, s, half, dist0, queue)
+        # copy visited set because queue is reused by the isometry check
+        visited = queue[:cnt0].copy()
+        path[0] = s
+        onpath[s] = True
+        depth = 0  # index of last vertex on path
+        it[0] = indptr[s]
+        # phase flags recomputed from the distance profile
+        while depth >= 0:
+            x = path[depth]
+            if it[depth] >= indptr[x + 1]:
+                if depth > 0:
+                    onpath[x] = False
+                depth -= 1
+                continue
+            y = indices[it[depth]]
+            it[depth] += 1
+            if y < s:
+                continue
+            L_now = depth + 1  # vertices on path
+            if y == s:
+                # closing edge: need at least 3 vertices and last vertex at distance 1
+                if L_now >= 3 and dist0[x] == 1 and path[1] < x:
+                    L = L_now
+                    if _is_isometric(indptr, indices, path, L, dist, queue):
+                        if nc == cap_c:
+                            cap_c *= 2
+                            tmp = np.empty(cap_c + 1, dtype=np.int64)
+                            tmp[: nc + 1] = offs[: nc + 1]
+                            offs = tmp
+                        if offs[nc] + L > cap_v:
+                            cap_v = max(cap_v * 2, offs[nc] + L)
+                            tmpv = np.empty(cap_v, dtype=np.int64)
+                            tmpv[: offs[nc]] = verts[: offs[nc]]
+                            verts = tmpv
+                        for q in range(L):
+                            verts[offs[nc] + q] = path[q]
+                        offs[nc + 1] = offs[nc] + L
+                        nc += 1
+                continue
+            if onpath[y] or L_now >= max_len:
+                continue
+            dy = dist0[y]
+            if dy < 0:
+                continue
+            dx = dist0[x]
+            # admissible distance profiles: rise by 1 while no fall happened,
+            # one level step at the top, then fall by 1.
+            rising = True
+            level_used = False
+            for q in range(1, depth + 1):
+                if dist0[path[q]] < dist0[path[q - 1]]:
+                    rising = False
+                elif dist0[path[q]] == dist0[path[q - 1]]:
+                    level_used = True
+                    rising = False
+            if dy == dx + 1:
+                if not rising:
+                    continue
+            elif dy == dx:
+                if not rising or level_used or depth == 0:
+                    continue
+            elif dy == dx - 1:
+                if depth == 0:
+                    continue
+            else:
+                continue
+            # remaining length must allow to come back: need dy more steps
+            if L_now + dy > max_len:
+                continue
+            depth += 1
+            path[depth] = y
+            onpath[y] = True
+            it[depth] = indptr[y]
+        onpath[s] = False
+        for q in range(cnt0):
+            dist0[visited[q]] = -1
+    return offs[: nc + 1].copy(), verts[: offs[nc]].copy()

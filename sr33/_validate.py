@@ -1,0 +1,87 @@
+"""The one validation layer: every message names the argument, the rule and
+what was found.  Errors subclass :class:`ValueError`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class InputError(ValueError):
+    """Bad input to sr33: the message says which argument and why."""
+
+
+def as_points(points, name: str = "points") -> np.ndarray:
+    """Return ``points`` as a C-contiguous float64 (n, 3) array or raise."""
+    try:
+        arr = np.asarray(points, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be numeric, could not convert: {exc}") from None
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise InputError(f"{name} must have shape (n, 3), got {arr.shape}")
+    bad = ~np.isfinite(arr).all(axis=1)
+    if bad.any():
+        first = int(np.flatnonzero(bad)[0])
+        raise InputError(
+            f"{name} contain {int(bad.sum())} non-finite (NaN or inf) coordinates rows, "
+            f"first at row {first}"
+        )
+    if arr.shape[0] < 4:
+        raise InputError(f"{name} must hold at least 4 points, got {arr.shape[0]}")
+    return np.ascontiguousarray(arr)
+
+
+def check_not_degenerate(points: np.ndarray, name: str = "points") -> None:
+    """Raise if the points span less than a plane (all collinear or equal)."""
+    centred = points - points.mean(axis=0)
+    s = np.linalg.svd(centred, compute_uv=False)
+    if s[0] == 0.0 or s[1] <= 1e-12 * s[0]:
+        raise InputError(
+            f"{name} are degenerate: all {points.shape[0]} points lie on one line, "
+            "a surface needs points spanning at least a plane"
+        )
+
+
+def check_unique(points: np.ndarray, name: str = "points") -> None:
+    """Raise if ``points`` holds exact duplicates (the steps need distinct samples)."""
+    n_unique = np.unique(points, axis=0).shape[0]
+    if n_unique != points.shape[0]:
+        raise InputError(
+            f"{name} contain {points.shape[0] - n_unique} exact duplicate points; "
+            "merge them first (sr33.reconstruct does this and reports the count)"
+        )
+
+
+def check_k(k, n: int) -> int:
+    """Return ``k`` as int if 3 <= k < n, else raise."""
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
+        raise InputError(f"k must be an integer, got {type(k).__name__} {k!r}")
+    k = int(k)
+    if k < 3:
+        raise InputError(f"k must be at least 3, got {k}")
+    if k >= n:
+        raise InputError(f"k must be less than the number of distinct points ({n}), got {k}")
+    return k
+
+
+def check_max_cycle_length(max_length, name: str = "max_cycle_length") -> int:
+    """Return the cycle length bound as int if it is at least 3."""
+    if isinstance(max_length, bool) or not isinstance(max_length, (int, np.integer)):
+        raise InputError(f"{name} must be an integer, got {type(max_length).__name__}")
+    if max_length < 3:
+        raise InputError(f"{name} must be at least 3, got {max_length}")
+    return int(max_length)
+
+
+def as_edges(edges, n: int, name: str = "edges") -> np.ndarray:
+    """Return ``edges`` as int64 (m, 2) with endpoints in range and distinct."""
+    arr = np.asarray(edges)
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        raise InputError(f"{name} must have shape (m, 2), got {arr.shape}")
+    if arr.size and not np.issubdtype(arr.dtype, np.integer):
+        raise InputError(f"{name} must be integer indices, got dtype {arr.dtype}")
+    arr = arr.astype(np.int64)
+    if arr.size and (arr.min() < 0 or arr.max() >= n):
+        raise InputError(f"{name} index points out of range 0..{n - 1}")
+    if np.any(arr[:, 0] == arr[:, 1]):
+        raise InputError(f"{name} contain loops (an edge from a point to itself)")
+    return np.ascontiguousarray(arr)

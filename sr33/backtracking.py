@@ -1,0 +1,623 @@
+"""Backtracking (Algorithm 4 of the paper, Section 4): a 2-basis of face cycles.
+
+Algorithm 4 grows a set of face cycles under *the backtracking invariant*
+(every edge is used at most twice, a new face shares an edge used once) and
+accepts a maximal set when *the success condition* holds: every
+Conv(N(u; k)) ∩ P' is a disk.  Tried literally, the search is exponential.
+This module searches the same space, made tractable by four observations:
+
+1. **Unambiguous cycles are fixed.**  An edge lying in exactly two small
+   isometric cycles is used by both in every closed solution (each edge of a
+   closed 2-basis is used exactly twice), and an edge in one cycle only is a
+   boundary edge of that cycle (the open L sheet).  A cycle all of whose
+   edges are like this, and which folds onto no neighbour, is selected
+   outright.  Under the sample conditions this is almost every cycle:
+   Theorem 2 (Lemmas 4, 5) makes the localized RNG equal the Urquhart graph
+   on smooth parts, whose small isometric cycles are exactly its faces.
+2. **The rest splits into independent local problems.**  The remaining
+   ("free") cycles contain an edge in three or more cycles, or fold onto a
+   neighbour (see :class:`sr33.tolerance.Tolerance`).  They are grouped into
+   components connected through shared edges.  Condition II-iii puts each
+   face cycle inside one k-neighbourhood and Theorems 3 and 4 confine the
+   ambiguity to neighbourhoods of sharp edges, corners and sharp points, so
+   these components are small and solved one by one; a choice in one cannot
+   affect the edge counts of another.
+3. **Each component is a constraint search with propagation** (DPLL-style
+   backtracking): every edge must end with 0 or 2 uses (fixed boundary edges
+   keep their single use), a selected cycle excludes every cycle folding onto
+   it, and once all cycles at a vertex are decided its link must be one
+   cycle or one path (a disk: the vertex form of the success condition) and
+   not empty if the vertex had candidates.  Forced moves (an edge used once
+   with one candidate left, an edge used twice, an edge unused with a single
+   candidate) are propagated before branching.  Branching picks the most
+   constrained edge and tries its best-ranked cycle first; ranking is by
+   length, then flatness, then the canonical vertex order, so the first
+   solution found is the one Algorithm 4 would return with candidates tried
+   in that order.
+4. **A budget bounds the search.**  Each component gets ``budget``
+   assignments.  When the strict search fails or exhausts the budget (the
+   sample conditions do not hold there), the component falls back to a
+   greedy pass in rank order that keeps the invariant (no edge above two
+   uses, no vertex link that is not a disk), and the result reports the
+   edges and samples that could not be closed.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse import csgraph
+
+from ._progress import bar
+from ._validate import InputError, as_points, as_edges
+from .cycles import CycleSet
+from .graph import cycle_edges, lookup_edges
+from .tolerance import DEFAULT, Tolerance
+
+
+@dataclass(frozen=True)
+class FaceSelection:
+    """Result of :func:`backtracking`.
+
+    Attributes
+    ----------
+    faces : CycleSet
+        The selected face cycles (the 2-basis), in the input cycle order.
+    selected : (c,) bool
+        Which input cycles were selected.
+    success : bool
+        True when the success condition held: no edge used more than twice,
+        every used sample's link a disk, no sample left without a face, and
+        no component needed the greedy fallback.
+    open_edges : (p, 2) int64
+        Edges of the selection used once (the boundary; empty when closed).
+    unresolved_samples : (q,) int64
+        Samples whose link is not a disk, or that no selected face uses.
+    components : int
+        Number of independent ambiguous components searched.
+    fallback_components : int
+        How many of them fell back to the greedy pass.
+    assignments : int
+        Total search assignments made (a measure of the work done).
+    """
+
+    faces: CycleSet
+    selected: np.ndarray
+    success: bool
+    open_edges: np.ndarray
+    unresolved_samples: np.ndarray
+    components: int
+    fallback_components: int
+    assignments: int
+    notes: tuple[str, ...] = field(default=())
+
+
+def _cycle_geometry(points, cs: CycleSet):
+    """Centroid and non-planarity (smallest singular value / perimeter) per cycle."""
+    lengths = cs.lengths
+    owner = np.repeat(np.arange(len(cs)), lengths)
+    p = points[cs.vertices]
+    sums = np.zeros((len(cs), 3))
+    np.add.at(sums, owner, p)
+    cen = sums / lengths[:, None]
+    flat = np.zeros(len(cs))
+    nxt_pairs, _ = cycle_edges(cs.offsets, cs.vertices)
+    seg = np.linalg.norm(points[nxt_pairs[:, 0]] - points[nxt_pairs[:, 1]], axis=1)
+    perim = np.zeros(len(cs))
+    np.add.at(perim, owner, seg)
+    for L in np.unique(lengths):
+        if L <= 3:
+            continue
+        sel = np.flatnonzero(lengths == L)
+        idx = cs.offsets[sel][:, None] + np.arange(L)[None, :]
+        q = points[cs.vertices[idx]] - cen[sel][:, None, :]
+        s = np.linalg.svd(q, compute_uv=False)
+        flat[sel] = s[:, -1] / perim[sel]
+    return cen, flat
+
+
+def _rank(cs: CycleSet, flat: np.ndarray, rtol: float) -> np.ndarray:
+    """Rank of every cycle: length, then flatness, then canonical order."""
+    q = np.round(flat / max(rtol, 1e-300) * 1e-3)  # flatness to ~1e-6 relative
+    order = np.lexsort((np.arange(len(cs)), q, cs.lengths))
+    rank = np.empty(len(cs), dtype=np.int64)
+    rank[order] = np.arange(len(cs))
+    return rank
+
+
+def _fold_pairs(points, edges, inc_edge, inc_cycle, centroid, fold_degrees):
+    """Pairs of cycles sharing an edge whose wings are closer than the fold angle."""
+    order = np.lexsort((inc_cycle, inc_edge))
+    e_sorted = inc_edge[order]
+    c_sorted = inc_cycle[order]
+    a = points[edges[e_sorted, 0]]
+    b = points[edges[e_sorted, 1]]
+    d = b - a
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    w = centroid[c_sorted] - 0.5 * (a + b)
+    w -= (w * d).sum(axis=1)[:, None] * d
+    norm = np.linalg.norm(w, axis=1)
+    w /= np.where(norm > 0, norm, 1.0)[:, None]
+    cos_lim = np.cos(np.radians(fold_degrees))
+    starts = np.flatnonzero(np.r_[True, e_sorted[1:] != e_sorted[:-1]])
+    ends = np.r_[starts[1:], e_sorted.shape[0]]
+    pairs = []
+    multi = np.flatnonzero(ends - starts >= 2)
+    for g in multi:
+        s, t = starts[g], ends[g]
+        ww = w[s:t]
+        cosm = ww @ ww.T
+        ii, jj = np.nonzero(np.triu(cosm > cos_lim, 1))
+        for i, j in zip(ii, jj):
+            pairs.append((c_sorted[s + i], c_sorted[s + j]))
+    if not pairs:
+        return np.empty((0, 2), dtype=np.int64)
+    return np.unique(np.sort(np.array(pairs, dtype=np.int64), axis=1), axis=0)
+
+
+def _link_is_disk(corners: list[tuple[int, int]]) -> bool:
+    """True when the corner pairs (prev, next) at a vertex form one path or one cycle."""
+    if not corners:
+        return False
+    deg: dict[int, int] = {}
+    adj: dict[int, list[int]] = {}
+    for p, q in corners:
+        if p == q:
+            return False
+        deg[p] = deg.get(p, 0) + 1
+        deg[q] = deg.get(q, 0) + 1
+        adj.setdefault(p, []).append(q)
+        adj.setdefault(q, []).append(p)
+    if max(deg.values()) > 2:
+        return False
+    # connected?
+    start = next(iter(adj))
+    seen = {start}
+    stack = [start]
+    while stack:
+        x = stack.pop()
+        for y in adj[x]:
+            if y not in seen:
+                seen.add(y)
+                stack.append(y)
+    return len(seen) == len(adj)
+
+
+def _link_is_partial_ok(corners: list[tuple[int, int]]) -> bool:
+    """True when corner pairs can still grow into one disk: paths, or one lone cycle."""
+    if not corners:
+        return True
+    deg: dict[int, int] = {}
+    for p, q in corners:
+        if p == q:
+            return False
+        deg[p] = deg.get(p, 0) + 1
+        deg[q] = deg.get(q, 0) + 1
+    if max(deg.values()) > 2:
+        return False
+    # a closed cycle is only fine if it is everything
+    n_edges = len(corners)
+    n_nodes = len(deg)
+    if n_edges >= n_nodes:  # contains a cycle
+        return _link_is_disk(corners)
+    return True
+
+
+class _Problem:
+    """Shared incidence tables of one backtracking run."""
+
+    def __init__(self, cs: CycleSet, edges: np.ndarray, n: int):
+        pairs, owner = cycle_edges(cs.offsets, cs.vertices)
+        eid = lookup_edges(edges, pairs, n)
+        if np.any(eid < 0):
+            raise InputError("cycles use a pair of points that is not an edge of the graph")
+        self.cycle_edge_ids = [eid[cs.offsets[i] : cs.offsets[i + 1]] for i in range(len(cs))]
+        self.inc_edge = eid
+        self.inc_cycle = owner
+        m = edges.shape[0]
+        ec = sparse.csr_matrix(
+            (np.ones(eid.shape[0], dtype=np.int8), (eid, owner)), shape=(m, len(cs))
+        )
+        ec.sort_indices()
+        self.edge_cycles = ec
+        self.n_cycles_at_edge = np.diff(ec.indptr)
+        # corners: for every cycle and vertex position, (vertex, prev, next)
+        verts = cs.vertices
+        nxt = np.arange(verts.shape[0]) + 1
+        nxt[cs.offsets[1:] - 1] = cs.offsets[:-1]
+        prv = np.arange(verts.shape[0]) - 1
+        prv[cs.offsets[:-1]] = cs.offsets[1:] - 1
+        self.corner_vertex = verts
+        self.corner_prev = verts[prv]
+        self.corner_next = verts[nxt]
+        self.corner_owner = owner
+        vc = sparse.csr_matrix(
+            (np.arange(1, verts.shape[0] + 1), (verts, owner)), shape=(n, len(cs))
+        )
+        vc.sort_indices()
+        self.vertex_cycles = vc  # data - 1 = corner index
+
+    def cycles_at_edge(self, e: int) -> np.ndarray:
+        ec = self.edge_cycles
+        return ec.indices[ec.indptr[e] : ec.indptr[e + 1]]
+
+    def corners_at_vertex(self, v: int):
+        vc = self.vertex_cycles
+        lo, hi = vc.indptr[v], vc.indptr[v + 1]
+        return vc.indices[lo:hi], vc.data[lo:hi] - 1
+
+
+class _Budget(Exception):
+    pass
+
+
+def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
+    """Strict DPLL search on one component; mutates ``state`` (1/0) on success."""
+    comp = sorted(comp, key=lambda c: rank[c])
+    comp_set = set(comp)
+    edges = sorted({int(e) for c in comp for e in prob.cycle_edge_ids[c]})
+    cnt = {}
+    rem = {}
+    for e in edges:
+        cyc = prob.cycles_at_edge(e)
+        cnt[e] = int(sum(1 for c in cyc if state[c] == 1))
+        rem[e] = int(sum(1 for c in cyc if int(c) in comp_set))
+    verts = sorted({int(v) for c in comp for v in prob.corner_vertex[_corner_slice(prob, c)]})
+    vrem = {}
+    for v in verts:
+        cyc, _ = prob.corners_at_vertex(v)
+        vrem[v] = int(sum(1 for c in cyc if int(c) in comp_set))
+    x = {c: -1 for c in comp}
+    has_fixed = bool(np.any(state == 1))
+    trail: list[int] = []
+    counter = [0]
+
+    def vertex_ok(v):
+        cyc, corner = prob.corners_at_vertex(v)
+        pairs = []
+        for c, k in zip(cyc, corner):
+            c = int(c)
+            on = x[c] == 1 if c in x else state[c] == 1
+            if on:
+                pairs.append((int(prob.corner_prev[k]), int(prob.corner_next[k])))
+        if vrem[v] == 0:
+            return _link_is_disk(pairs)
+        return _link_is_partial_ok(pairs)
+
+    def assign(c, val, queue_e, queue_v):
+        counter[0] += 1
+        if counter[0] > budget:
+            raise _Budget
+        x[c] = val
+        trail.append(c)
+        for e in prob.cycle_edge_ids[c]:
+            e = int(e)
+            rem[e] -= 1
+            if val == 1:
+                cnt[e] += 1
+            queue_e.append(e)
+        for v in prob.corner_vertex[_corner_slice(prob, c)]:
+            v = int(v)
+            vrem[v] -= 1
+            queue_v.append(v)
+
+    def unassign_to(mark):
+        while len(trail) > mark:
+            c = trail.pop()
+            val = x[c]
+            for e in prob.cycle_edge_ids[c]:
+                e = int(e)
+                rem[e] += 1
+                if val == 1:
+                    cnt[e] -= 1
+            for v in prob.corner_vertex[_corner_slice(prob, c)]:
+                vrem[int(v)] += 1
+            x[c] = -1
+
+    def propagate(queue_e, queue_v):
+        while queue_e or queue_v:
+            if queue_e:
+                e = queue_e.pop()
+                ce, re = cnt[e], rem[e]
+                if ce > 2:
+                    return False
+                if re == 0:
+                    if ce == 1 and prob.n_cycles_at_edge[e] > 1:
+                        return False
+                    continue
+                und = [int(c) for c in prob.cycles_at_edge(e) if int(c) in x and x[int(c)] == -1]
+                if ce == 2:
+                    for c in und:
+                        if x[c] == -1:
+                            assign(c, 0, queue_e, queue_v)
+                elif ce == 1 and re == 1:
+                    c = und[0]
+                    assign(c, 1, queue_e, queue_v)
+                    for d in conflicts.get(c, ()):
+                        if d in x:
+                            if x[d] == 1:
+                                return False
+                            if x[d] == -1:
+                                assign(d, 0, queue_e, queue_v)
+                        elif state[d] == 1:
+                            return False
+                elif ce == 0 and re == 1:
+                    assign(und[0], 0, queue_e, queue_v)
+            else:
+                v = queue_v.pop()
+                if not vertex_ok(v):
+                    return False
+        return True
+
+    def choose():
+        best = None
+        for e in edges:
+            if rem[e] >= 2 and cnt[e] < 2:
+                key = (0 if cnt[e] == 1 else 1, rem[e], e)
+                if best is None or key < best[0]:
+                    best = (key, e)
+        if best is None:
+            for c in comp:
+                if x[c] == -1:
+                    return c
+            return None
+        e = best[1]
+        und = [int(c) for c in prob.cycles_at_edge(e) if int(c) in x and x[int(c)] == -1]
+        return min(und, key=lambda c: rank[c])
+
+    def set_and_propagate(c, val):
+        qe: list[int] = []
+        qv: list[int] = []
+        if val == 1:
+            for d in conflicts.get(c, ()):
+                if d in x:
+                    if x[d] == 1:
+                        return False
+                elif state[d] == 1:
+                    return False
+        assign(c, val, qe, qv)
+        if val == 1:
+            for d in conflicts.get(c, ()):
+                if d in x and x[d] == -1:
+                    assign(d, 0, qe, qv)
+        return propagate(qe, qv)
+
+    def _all_attached(chosen):
+        # every chosen cycle must reach a fixed face through chosen faces
+        reached: set[int] = set()
+        for c0 in chosen:
+            if c0 in reached:
+                continue
+            seen = {c0}
+            stack = [c0]
+            ok = False
+            while stack:
+                c = stack.pop()
+                for e in prob.cycle_edge_ids[c]:
+                    for d in prob.cycles_at_edge(int(e)):
+                        d = int(d)
+                        if d in seen:
+                            continue
+                        if d in x:
+                            if x[d] == 1:
+                                seen.add(d)
+                                stack.append(d)
+                        elif state[d] == 1:
+                            ok = True
+            if not ok:
+                return False
+            reached |= seen
+        return True
+
+    def search():
+        c = choose()
+        if c is None:
+            return _all_attached([c for c in comp if x[c] == 1]) if has_fixed else True
+        for val in (1, 0):
+            mark = len(trail)
+            if set_and_propagate(c, val) and search():
+                return True
+            unassign_to(mark)
+        return False
+
+    # initial propagation over everything
+    qe = list(edges)
+    qv = list(verts)
+    ok = propagate(qe, qv) and search()
+    if ok:
+        for c in comp:
+            state[c] = 1 if x[c] == 1 else 0
+    return ok, counter[0]
+
+
+def _corner_slice(prob: _Problem, c: int) -> slice:
+    ids = prob.cycle_edge_ids[c]
+    # corners of cycle c are contiguous, same span as its cycle edges
+    start = prob._offsets[c]
+    return slice(start, start + ids.shape[0])
+
+
+def _greedy(prob: _Problem, comp, state, rank, conflicts):
+    """Fallback: add cycles in rank order while edge use <= 2 and links stay disks."""
+    comp = sorted(comp, key=lambda c: rank[c])
+    for c in comp:
+        state[c] = 0
+    use: dict[int, int] = {}
+    for c in comp:
+        for e in prob.cycle_edge_ids[c]:
+            e = int(e)
+            if e not in use:
+                use[e] = int(sum(1 for d in prob.cycles_at_edge(e) if state[d] == 1))
+    for c in comp:
+        if any(use[int(e)] >= 2 for e in prob.cycle_edge_ids[c]):
+            continue
+        if any(state[d] == 1 for d in conflicts.get(c, ())):
+            continue
+        state[c] = 1
+        ok = True
+        for v in prob.corner_vertex[_corner_slice(prob, c)]:
+            cyc, corner = prob.corners_at_vertex(int(v))
+            pairs = [
+                (int(prob.corner_prev[k]), int(prob.corner_next[k]))
+                for d, k in zip(cyc, corner)
+                if state[d] == 1
+            ]
+            if not _link_is_partial_ok(pairs):
+                ok = False
+                break
+        if not ok:
+            state[c] = 0
+            continue
+        for e in prob.cycle_edge_ids[c]:
+            use[int(e)] += 1
+
+
+def backtracking(
+    points,
+    edges,
+    cycles: CycleSet,
+    *,
+    tolerance: Tolerance = DEFAULT,
+    budget: int = 20000,
+    quiet: bool = True,
+) -> FaceSelection:
+    """Backtracking({}, {◇_i}, k): Algorithm 4, a closed manifold set of face cycles.
+
+    See the module docstring for the design and the lemmas each part relies
+    on.  Departures from the paper: candidates are decided by constraint
+    propagation over independent components rather than one global
+    recursion, the vertex link condition stands in for
+    "Conv(N(u; k)) ∩ P' is a disk", and a per-component budget bounds the
+    search (exhausting it is reported, never silent).
+
+    Parameters
+    ----------
+    points : (n, 3) array_like of float
+        The samples.
+    edges : (m, 2) array_like of int
+        The localized RNG (sorted rows ``a < b``).
+    cycles : CycleSet
+        Candidate cycles, normally from :func:`trivial_isometric_cycles`.
+    tolerance : Tolerance
+        ``fold_degrees`` decides which neighbouring cycles fold onto each other.
+    budget : int
+        Maximum assignments of the strict search per component.
+    quiet : bool
+        Hide the progress bar.
+
+    Returns
+    -------
+    FaceSelection
+    """
+    pts = as_points(points)
+    n = pts.shape[0]
+    e = as_edges(edges, n)
+    e = np.unique(np.sort(e, axis=1), axis=0) if e.shape[0] else e
+    if not isinstance(budget, (int, np.integer)) or budget < 1:
+        raise InputError(f"budget must be a positive integer, got {budget!r}")
+    nc = len(cycles)
+    if nc == 0:
+        return FaceSelection(
+            faces=cycles,
+            selected=np.zeros(0, bool),
+            success=False,
+            open_edges=np.empty((0, 2), np.int64),
+            unresolved_samples=np.arange(n, dtype=np.int64),
+            components=0,
+            fallback_components=0,
+            assignments=0,
+            notes=("no candidate cycles",),
+        )
+    prob = _Problem(cycles, e, n)
+    prob._offsets = cycles.offsets
+    centroid, flat = _cycle_geometry(pts, cycles)
+    rank = _rank(cycles, flat, tolerance.rtol)
+    folds = _fold_pairs(pts, e, prob.inc_edge, prob.inc_cycle, centroid, tolerance.fold_degrees)
+    conflicts: dict[int, list[int]] = {}
+    for a, b in folds:
+        conflicts.setdefault(int(a), []).append(int(b))
+        conflicts.setdefault(int(b), []).append(int(a))
+
+    ambiguous_edge = prob.n_cycles_at_edge >= 3
+    free = np.zeros(nc, dtype=bool)
+    free[np.unique(prob.inc_cycle[ambiguous_edge[prob.inc_edge]])] = True
+    if folds.shape[0]:
+        free[folds.ravel()] = True
+    state = np.where(free, -1, 1).astype(np.int64)
+
+    # components of free cycles linked through shared edges
+    free_idx = np.flatnonzero(free)
+    comps: list[list[int]] = []
+    if free_idx.shape[0]:
+        inc = free[prob.inc_cycle]
+        b = sparse.csr_matrix(
+            (np.ones(int(inc.sum()), dtype=np.int8), (prob.inc_cycle[inc], prob.inc_edge[inc] + nc)),
+            shape=(nc + e.shape[0], nc + e.shape[0]),
+        )
+        ncomp, labels = csgraph.connected_components(b, directed=False)
+        lab = labels[free_idx]
+        order = np.argsort(lab, kind="stable")
+        lab_sorted = lab[order]
+        splits = np.flatnonzero(np.diff(lab_sorted)) + 1
+        comps = [list(map(int, g)) for g in np.split(free_idx[order], splits)]
+        comps.sort(key=lambda g: min(rank[c] for c in g))
+
+    old_limit = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(old_limit, 20000))
+    total = 0
+    fallback = 0
+    try:
+        with bar(len(comps), "backtracking", quiet) as pbar:
+            for comp in comps:
+                snapshot = state.copy()
+                try:
+                    ok, used = _solve_component(prob, comp, state, rank, conflicts, budget)
+                except _Budget:
+                    ok, used = False, budget
+                total += used
+                if not ok:
+                    state[:] = snapshot
+                    fallback += 1
+                    _greedy(prob, comp, state, rank, conflicts)
+                pbar.update(1)
+    finally:
+        sys.setrecursionlimit(old_limit)
+
+    selected = state == 1
+    faces = cycles.subset(selected)
+    # final checks: edge use, links, coverage
+    use = np.bincount(prob.inc_edge[selected[prob.inc_cycle]], minlength=e.shape[0])
+    open_edges = e[use == 1]
+    over = int((use > 2).sum())
+    sel_corner = selected[prob.corner_owner]
+    unresolved = []
+    cv = prob.corner_vertex[sel_corner]
+    cp = prob.corner_prev[sel_corner]
+    cn = prob.corner_next[sel_corner]
+    order = np.argsort(cv, kind="stable")
+    cv, cp, cn = cv[order], cp[order], cn[order]
+    starts = np.searchsorted(cv, np.arange(n))
+    stops = np.searchsorted(cv, np.arange(n), side="right")
+    for v in range(n):
+        s, t = starts[v], stops[v]
+        if s == t or not _link_is_disk(list(zip(cp[s:t].tolist(), cn[s:t].tolist()))):
+            unresolved.append(v)
+    unresolved_arr = np.array(unresolved, dtype=np.int64)
+    success = over == 0 and unresolved_arr.shape[0] == 0 and fallback == 0
+    notes = []
+    if over:
+        notes.append(f"{over} edges used more than twice")
+    return FaceSelection(
+        faces=faces,
+        selected=selected,
+        success=bool(success),
+        open_edges=open_edges,
+        unresolved_samples=unresolved_arr,
+        components=len(comps),
+        fallback_components=fallback,
+        assignments=total,
+        notes=tuple(notes),
+    )

@@ -1,0 +1,111 @@
+"""Cones for stray samples (end of Section 5 of the paper).
+
+Theorem 5 leaves a defect: the output need not use every sample.  The paper
+remedies it by attaching stray samples with cones whose triangles keep
+interiors disjoint.  Here a stray sample p is coned over the triangle t
+nearest to it: t is replaced by the three triangles joining p to t's edges.
+That is a subdivision of t, so the topology of the surface is unchanged and
+no two triangle interiors meet.  Orientation is inherited from t.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ._validate import InputError, as_points
+
+
+def _closest_on_triangle(p, a, b, c):
+    """Distance from p to triangle abc (Ericson, Real-Time Collision Detection 5.1.5)."""
+    ab, ac, ap = b - a, c - a, p - a
+    d1, d2 = ab @ ap, ac @ ap
+    if d1 <= 0 and d2 <= 0:
+        return np.linalg.norm(p - a)
+    bp = p - b
+    d3, d4 = ab @ bp, ac @ bp
+    if d3 >= 0 and d4 <= d3:
+        return np.linalg.norm(p - b)
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0 and d1 >= 0 and d3 <= 0:
+        v = d1 / (d1 - d3)
+        return np.linalg.norm(p - (a + v * ab))
+    cp = p - c
+    d5, d6 = ab @ cp, ac @ cp
+    if d6 >= 0 and d5 <= d6:
+        return np.linalg.norm(p - c)
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0 and d2 >= 0 and d6 <= 0:
+        w = d2 / (d2 - d6)
+        return np.linalg.norm(p - (a + w * ac))
+    va = d3 * d6 - d5 * d4
+    if va <= 0 and (d4 - d3) >= 0 and (d5 - d6) >= 0:
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        return np.linalg.norm(p - (b + w * (c - b)))
+    denom = 1.0 / (va + vb + vc)
+    v, w = vb * denom, vc * denom
+    return np.linalg.norm(p - (a + ab * v + ac * w))
+
+
+def attach_cones(points, triangles, *, candidates: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    """Attach every sample no triangle uses, by a cone over its nearest triangle.
+
+    Parameters
+    ----------
+    points : (n, 3) array_like of float
+        The samples.
+    triangles : (t, 3) array_like of int
+        The triangulated output.
+    candidates : int
+        How many triangles (nearest by centroid) are searched per stray sample.
+
+    Returns
+    -------
+    triangles : (t + 2s, 3) int64
+        The triangles with every stray sample coned in.
+    strays : (s,) int64
+        The samples that were attached, in the order they were processed
+        (ascending index).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sr33 import attach_cones
+    >>> p = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0.2, 0.2, 0.01]])
+    >>> tri, strays = attach_cones(p, [(0, 1, 2)])
+    >>> strays.tolist(), tri.shape
+    ([3], (3, 3))
+    """
+    pts = as_points(points)
+    tri = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    if tri.shape[0] == 0:
+        raise InputError("triangles is empty: there is no surface to attach samples to")
+    if tri.min() < 0 or tri.max() >= pts.shape[0]:
+        raise InputError("triangles index points out of range")
+    used = np.zeros(pts.shape[0], dtype=bool)
+    used[tri.ravel()] = True
+    strays = np.flatnonzero(~used)
+    if strays.shape[0] == 0:
+        return tri.copy(), strays
+    tris = [tuple(t) for t in tri.tolist()]
+    alive = [True] * len(tris)
+    for p in strays.tolist():
+        live = [i for i, ok in enumerate(alive) if ok]
+        cen = pts[np.array([tris[i] for i in live])].mean(axis=1)
+        tree = cKDTree(cen)
+        kq = min(candidates, len(live))
+        _, near = tree.query(pts[p], kq)
+        near = np.atleast_1d(near)
+        best, best_d = -1, np.inf
+        for j in near.tolist():
+            t = tris[live[j]]
+            d = _closest_on_triangle(pts[p], pts[t[0]], pts[t[1]], pts[t[2]])
+            if d < best_d or (d == best_d and live[j] < best):
+                best, best_d = live[j], d
+        a, b, c = tris[best]
+        alive[best] = False
+        for new in ((a, b, p), (b, c, p), (c, a, p)):
+            tris.append(new)
+            alive.append(True)
+    out = np.array([t for t, ok in zip(tris, alive) if ok], dtype=np.int64)
+    return out, strays

@@ -1,0 +1,223 @@
+"""Reading samples and meshes, writing meshes atomically.
+
+Point lists: ``.xyz``/``.txt`` (whitespace or comma separated, first three
+columns), ``.npy`` ((n, 3) array), ``.obj`` (``v`` lines; faces ignored).
+Meshes: ``.ply``, ``.off``, ``.stl``, ``.obj`` through meshio, ``.vtp``
+through PyVista (optional extra ``vtk``); as inputs their vertices are the
+samples.  Every failure becomes :class:`ReadError` / :class:`WriteError`
+with the path and the reason; outputs go to a temporary file in the target
+directory that is renamed into place, so a failed write leaves nothing.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ._validate import InputError
+
+POINT_FORMATS = (".xyz", ".txt", ".npy")
+MESH_FORMATS = (".ply", ".obj", ".off", ".stl", ".vtp")
+
+
+class ReadError(InputError):
+    """An input file could not be read."""
+
+
+class WriteError(InputError):
+    """An output file could not be written."""
+
+
+def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    verts: list[list[float]] = []
+    faces: list[list[int]] = []
+    with open(path, encoding="utf-8", errors="strict") as fh:
+        for lineno, line in enumerate(fh, 1):
+            parts = line.split()
+            if not parts:
+                continue
+            if parts[0] == "v":
+                if len(parts) < 4:
+                    raise ReadError(f"{path}: line {lineno}: vertex needs 3 coordinates")
+                try:
+                    verts.append([float(parts[1]), float(parts[2]), float(parts[3])])
+                except ValueError:
+                    raise ReadError(f"{path}: line {lineno}: bad vertex coordinates") from None
+            elif parts[0] == "f" and len(parts) >= 4:
+                try:
+                    idx = [int(p.split("/")[0]) for p in parts[1:]]
+                except ValueError:
+                    raise ReadError(f"{path}: line {lineno}: bad face indices") from None
+                idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
+                for j in range(1, len(idx) - 1):
+                    faces.append([idx[0], idx[j], idx[j + 1]])
+    v = np.array(verts, dtype=np.float64).reshape(-1, 3)
+    f = np.array(faces, dtype=np.int64).reshape(-1, 3)
+    if f.size and (f.min() < 0 or f.max() >= v.shape[0]):
+        raise ReadError(f"{path}: face indices out of range")
+    return v, f
+
+
+def _read_text_points(path: Path) -> np.ndarray:
+    rows = []
+    with open(path, encoding="utf-8") as fh:
+        for lineno, line in enumerate(fh, 1):
+            s = line.strip()
+            if not s or s.startswith("#"):
+                continue
+            parts = s.replace(",", " ").split()
+            if len(parts) < 3:
+                raise ReadError(f"{path}: line {lineno}: expected 3 coordinates, got {len(parts)}")
+            try:
+                rows.append([float(parts[0]), float(parts[1]), float(parts[2])])
+            except ValueError:
+                raise ReadError(f"{path}: line {lineno}: coordinates are not numbers") from None
+    return np.array(rows, dtype=np.float64).reshape(-1, 3)
+
+
+def read_mesh(path) -> tuple[np.ndarray, np.ndarray]:
+    """Read ``(vertices, triangles)`` from a mesh or point file.
+
+    Point lists give an empty (0, 3) triangle array.  Polygons are fanned
+    into triangles.
+    """
+    p = Path(path)
+    ext = p.suffix.lower()
+    if ext not in POINT_FORMATS + MESH_FORMATS:
+        raise ReadError(
+            f"{p}: unsupported format {ext or '(none)'}; "
+            f"use one of {', '.join(POINT_FORMATS + MESH_FORMATS)}"
+        )
+    if not p.exists():
+        raise ReadError(f"{p}: no such file")
+    if p.is_dir():
+        raise ReadError(f"{p}: is a directory")
+    if p.stat().st_size == 0:
+        raise ReadError(f"{p}: file is empty")
+    empty_tri = np.empty((0, 3), dtype=np.int64)
+    try:
+        if ext == ".obj":
+            v, f = _read_obj(p)
+        elif ext in (".xyz", ".txt"):
+            v, f = _read_text_points(p), empty_tri
+        elif ext == ".npy":
+            arr = np.load(p, allow_pickle=False)
+            if arr.ndim != 2 or arr.shape[1] != 3:
+                raise ReadError(f"{p}: array must have shape (n, 3), got {arr.shape}")
+            v, f = arr.astype(np.float64), empty_tri
+        elif ext == ".vtp":
+            v, f = _read_vtp(p)
+        else:
+            import meshio
+
+            m = meshio.read(p)
+            v = np.asarray(m.points, dtype=np.float64)
+            if v.ndim != 2 or v.shape[1] < 3:
+                raise ReadError(f"{p}: vertices must be 3D")
+            v = v[:, :3]
+            tris = [np.asarray(c.data) for c in m.cells if c.type == "triangle"]
+            for c in m.cells:
+                if c.type in ("quad", "polygon") or c.type.startswith("polygon"):
+                    d = np.asarray(c.data)
+                    for j in range(1, d.shape[1] - 1):
+                        tris.append(d[:, [0, j, j + 1]])
+            f = np.concatenate(tris).astype(np.int64) if tris else empty_tri
+    except InputError:
+        raise
+    except UnicodeDecodeError:
+        raise ReadError(f"{p}: not a text {ext} file (could not decode)") from None
+    except Exception as exc:  # meshio/VTK raise many types; report them plainly
+        msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ReadError(f"{p}: unreadable or truncated {ext} file ({msg})") from None
+    if v.shape[0] == 0:
+        raise ReadError(f"{p}: contains no points")
+    return v, f
+
+
+def read_points(path) -> np.ndarray:
+    """Read the samples of a point or mesh file as an (n, 3) float64 array."""
+    return read_mesh(path)[0]
+
+
+def _read_vtp(p: Path):
+    try:
+        import pyvista as pv
+    except ImportError:
+        raise ReadError(f"{p}: reading .vtp needs PyVista: pip install 'sr33[vtk]'") from None
+    mesh = pv.read(p)
+    v = np.asarray(mesh.points, dtype=np.float64)
+    f = np.empty((0, 3), dtype=np.int64)
+    if mesh.n_cells:
+        tri = mesh.triangulate()
+        faces = np.asarray(tri.faces).reshape(-1, 4)
+        f = faces[:, 1:].astype(np.int64)
+    return v, f
+
+
+def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
+    """Write a triangle mesh atomically (temporary file, then rename).
+
+    The format follows the extension: ``.ply``, ``.obj``, ``.off``, ``.stl``
+    or ``.vtp``.  Same arrays give byte-identical files.
+    """
+    p = Path(path)
+    ext = p.suffix.lower()
+    if ext not in MESH_FORMATS:
+        raise WriteError(
+            f"{p}: unsupported output format {ext or '(none)'}; use one of {', '.join(MESH_FORMATS)}"
+        )
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.is_dir():
+        raise WriteError(f"{p}: directory {parent} does not exist")
+    if p.is_dir():
+        raise WriteError(f"{p}: is a directory")
+    v = np.ascontiguousarray(vertices, dtype=np.float64)
+    t = np.ascontiguousarray(triangles, dtype=np.int64)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}.", suffix=ext, dir=parent)
+    except OSError as exc:
+        raise WriteError(f"{p}: cannot write ({exc.strerror})") from None
+    os.close(fd)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+    try:
+        if ext == ".vtp":
+            try:
+                import pyvista as pv
+            except ImportError:
+                raise WriteError(f"{p}: writing .vtp needs PyVista: pip install 'sr33[vtk]'") from None
+            faces = np.hstack([np.full((t.shape[0], 1), 3, dtype=np.int64), t]).ravel()
+            pv.PolyData(v, faces).save(tmp, binary=True)
+        elif ext == ".obj":
+            with open(tmp, "w", encoding="ascii") as fh:
+                fh.write("# written by sr33\n")
+                np.savetxt(fh, v, fmt="v %.17g %.17g %.17g")
+                np.savetxt(fh, t + 1, fmt="f %d %d %d")
+        else:
+            import meshio
+
+            fmt = {".ply": "ply", ".off": "off", ".stl": "stl"}[ext]
+            # 32-bit indices: what PLY readers expect (and no meshio warning)
+            meshio.write_points_cells(tmp, v, [("triangle", t.astype(np.int32))], file_format=fmt)
+        os.replace(tmp, p)
+    except WriteError:
+        _unlink(tmp)
+        raise
+    except OSError as exc:
+        _unlink(tmp)
+        raise WriteError(f"{p}: cannot write ({exc.strerror or exc})") from None
+    except BaseException:
+        _unlink(tmp)
+        raise
+    return p
+
+
+def _unlink(path: str) -> None:
+    try:
+        os.unlink(path)
+    except OSError:
+        pass

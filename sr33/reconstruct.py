@@ -1,0 +1,167 @@
+"""Algorithm 1 of the paper: the whole reconstruction, step by step.
+
+``reconstruct`` validates and de-duplicates the samples, puts them in a
+canonical (lexicographic) order so that no decision depends on input order,
+runs LocalizedRNG → TrivialIsometricCycles → Backtracking → Triangulate →
+cones for stray samples, and maps the result back to the input's vertices.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ._progress import log, timed
+from ._validate import as_points, check_k, check_max_cycle_length, check_not_degenerate
+from .backtracking import backtracking
+from .cones import attach_cones
+from .cycles import CycleSet, trivial_isometric_cycles
+from .rng import localized_rng
+from .tolerance import DEFAULT, Tolerance
+from .triangulate import triangulate
+
+
+@dataclass(frozen=True)
+class Reconstruction:
+    """The result of :func:`reconstruct`; all indices refer to ``vertices``.
+
+    Attributes
+    ----------
+    vertices : (v, 3) float64
+        The distinct input samples, in order of first occurrence in the input.
+    triangles : (t, 3) int64
+        The output surface, consistently oriented where orientable.
+    input_to_vertex : (n,) int64
+        For every input point, its row in ``vertices`` (duplicates share one).
+    duplicates_merged : int
+        Number of input points that were exact duplicates of an earlier one.
+    rng_edges : (m, 2) int64
+        The localized RNG (Algorithm 2), rows ``(a, b)`` with ``a < b``, sorted.
+    candidate_cycles : int
+        Number of small isometric cycles found (Algorithm 3).
+    face_cycles : CycleSet
+        The selected 2-basis (Algorithm 4) before triangulation.
+    success : bool
+        Whether the backtracking met its success condition everywhere.
+    open_edges : (p, 2) int64
+        Edges of the face cycles used once (the boundary, or failures).
+    unresolved_samples : (q,) int64
+        Samples whose face-cycle link is not a disk or that no face cycle used.
+    coned_samples : (s,) int64
+        Samples attached by cones at the end (Section 5).
+    fallback_components : int
+        Ambiguous components where the strict search failed and the greedy
+        fallback was used (0 when ``success``).
+    timings : dict[str, float]
+        Seconds per step.
+    k : int
+        The neighbourhood size used.
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    input_to_vertex: np.ndarray
+    duplicates_merged: int
+    rng_edges: np.ndarray
+    candidate_cycles: int
+    face_cycles: CycleSet
+    success: bool
+    open_edges: np.ndarray
+    unresolved_samples: np.ndarray
+    coned_samples: np.ndarray
+    fallback_components: int
+    timings: dict[str, float] = field(default_factory=dict)
+    k: int = 33
+
+
+def reconstruct(
+    points,
+    k: int = 33,
+    *,
+    max_cycle_length: int = 8,
+    budget: int = 20000,
+    tolerance: Tolerance = DEFAULT,
+    quiet: bool = True,
+) -> Reconstruction:
+    """Reconstruct a surface with sharp features from point samples (Algorithm 1).
+
+    Parameters
+    ----------
+    points : (n, 3) array_like of float
+        The samples; exact duplicates are merged (``duplicates_merged``).
+    k : int
+        Neighbourhood size, ``3 <= k <`` number of distinct points.  The
+        paper uses 33 on its sharp-feature sets.
+    max_cycle_length : int
+        Longest candidate face cycle (Algorithm 3, see :mod:`sr33.cycles`).
+    budget : int
+        Search assignments per ambiguous component (see :mod:`sr33.backtracking`).
+    tolerance : Tolerance
+        Tie and fold tolerances (:mod:`sr33.tolerance`).
+    quiet : bool
+        Hide progress bars.
+
+    Returns
+    -------
+    Reconstruction
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sr33 import reconstruct
+    >>> octahedron = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0],
+    ...                        [0, -1, 0], [0, 0, 1], [0, 0, -1]], float)
+    >>> r = reconstruct(octahedron, k=4)
+    >>> r.triangles.shape, r.success
+    ((8, 3), True)
+    """
+    raw = as_points(points)
+    max_cycle_length = check_max_cycle_length(max_cycle_length)
+    timings: dict[str, float] = {}
+    with timed("prepare", timings):
+        uniq, first, inverse = np.unique(raw, axis=0, return_index=True, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        check_not_degenerate(uniq)
+        k = check_k(k, uniq.shape[0])
+        dup = raw.shape[0] - uniq.shape[0]
+        if dup:
+            log.info("merged %d exact duplicate points", dup)
+    pts = uniq  # canonical order: lexicographic by coordinates
+    with timed("localized_rng", timings):
+        rng = localized_rng(pts, k, tolerance=tolerance, quiet=quiet)
+    with timed("isometric_cycles", timings):
+        cycles = trivial_isometric_cycles(rng.edges, pts.shape[0], max_length=max_cycle_length)
+    with timed("backtracking", timings):
+        sel = backtracking(pts, rng.edges, cycles, tolerance=tolerance, budget=budget, quiet=quiet)
+    with timed("triangulate", timings):
+        tri = triangulate(pts, sel.faces, rtol=tolerance.rtol).triangles
+    with timed("cones", timings):
+        if tri.shape[0]:
+            tri, coned = attach_cones(pts, tri)
+        else:
+            coned = np.empty(0, dtype=np.int64)
+    # canonical -> output labels (order of first occurrence in the input)
+    out_order = np.argsort(first, kind="stable")
+    relabel = np.empty_like(out_order)
+    relabel[out_order] = np.arange(out_order.shape[0])
+    rng_edges = np.sort(relabel[rng.edges], axis=1)
+    rng_edges = rng_edges[np.lexsort((rng_edges[:, 1], rng_edges[:, 0]))]
+    open_edges = np.sort(relabel[sel.open_edges], axis=1) if sel.open_edges.size else sel.open_edges
+    faces = CycleSet(offsets=sel.faces.offsets, vertices=relabel[sel.faces.vertices])
+    return Reconstruction(
+        vertices=pts[out_order],
+        triangles=relabel[tri],
+        input_to_vertex=relabel[inverse],
+        duplicates_merged=int(dup),
+        rng_edges=rng_edges,
+        candidate_cycles=len(cycles),
+        face_cycles=faces,
+        success=bool(sel.success),
+        open_edges=open_edges,
+        unresolved_samples=np.sort(relabel[sel.unresolved_samples]),
+        coned_samples=np.sort(relabel[coned]),
+        fallback_components=sel.fallback_components,
+        timings=timings,
+        k=k,
+    )

@@ -1,0 +1,261 @@
+"""Triangulate (line 4 of Algorithm 1, Section 4) and the orientation of faces.
+
+Every face cycle is split into triangles whose interiors are pairwise
+disjoint and whose union is bounded by the cycle.  Each cycle is first
+oriented coherently with its neighbours (faces sharing an edge traverse it in
+opposite directions), so the triangles come out consistently oriented on
+every orientable component, outward on closed ones.
+
+A cycle of length L is triangulated by dynamic programming over its
+diagonals (O(L³), L <= max cycle length): minimum total area, never a
+diagonal that is already an edge of another face (it would be used three
+times).  Ties, such as the two diagonals of a planar square, are broken by
+the shorter diagonal, then by the canonical order of the samples.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse import csgraph
+
+from ._validate import InputError, as_points
+from .cycles import CycleSet
+from .graph import cycle_edges, edge_keys
+
+
+@dataclass(frozen=True)
+class Triangulation:
+    """Result of :func:`triangulate`.
+
+    Attributes
+    ----------
+    triangles : (t, 3) int64
+        Vertex indices, consistently oriented where the surface is orientable.
+    face_of_triangle : (t,) int64
+        The face cycle each triangle came from.
+    orientable : bool
+        False when some component could not be oriented coherently.
+    """
+
+    triangles: np.ndarray
+    face_of_triangle: np.ndarray
+    orientable: bool
+
+
+def orient_cycles(points: np.ndarray, faces: CycleSet) -> tuple[CycleSet, bool]:
+    """Reverse cycles so that neighbours traverse shared edges oppositely.
+
+    Breadth-first over the face adjacency (faces sharing an edge used by
+    exactly two faces), from the canonically smallest face of each component;
+    closed components are then flipped to enclose positive volume.
+    Returns the oriented cycles and whether every component was orientable.
+    """
+    n = points.shape[0]
+    nf = len(faces)
+    if nf == 0:
+        return faces, True
+    pairs, owner = cycle_edges(faces.offsets, faces.vertices)
+    keys = edge_keys(pairs[:, 0], pairs[:, 1], n)
+    forward = pairs[:, 0] < pairs[:, 1]
+    order = np.argsort(keys, kind="stable")
+    ks = keys[order]
+    same = np.flatnonzero(ks[1:] == ks[:-1])
+    # only edges shared by exactly two faces link faces
+    cnt_u, inv, cnt = np.unique(ks, return_inverse=True, return_counts=True)
+    two = cnt[inv[same]] == 2
+    a = order[same[two]]
+    b = order[same[two] + 1]
+    fa, fb = owner[a], owner[b]
+    # same direction on the shared edge -> the faces need opposite flips
+    need_flip = forward[a] == forward[b]
+    g = sparse.csr_matrix(
+        (np.ones(fa.shape[0] * 2, dtype=np.int8), (np.r_[fa, fb], np.r_[fb, fa])), shape=(nf, nf)
+    )
+    ncomp, labels = csgraph.connected_components(g, directed=False)
+    flip = np.zeros(nf, dtype=np.int8)
+    known = np.zeros(nf, dtype=bool)
+    rel = {}
+    for i, j, f in zip(fa.tolist(), fb.tolist(), need_flip.tolist()):
+        rel[(i, j)] = f
+        rel[(j, i)] = f
+    for comp in range(ncomp):
+        root = int(np.flatnonzero(labels == comp)[0])
+        bfs, pred = csgraph.breadth_first_order(g, root, directed=False)
+        known[root] = True
+        for v in bfs[1:]:
+            p = pred[v]
+            flip[v] = flip[p] ^ rel[(int(p), int(v))]
+            known[v] = True
+    orientable = bool(np.all(flip[fa] ^ flip[fb] == need_flip))
+    # flip closed components to positive volume
+    verts = faces.vertices.copy()
+    lengths = faces.lengths
+    out_parts = []
+    for i in range(nf):
+        c = verts[faces.offsets[i] : faces.offsets[i + 1]]
+        out_parts.append(c if not flip[i] else np.r_[c[0], c[:0:-1]])
+    oriented = CycleSet(offsets=faces.offsets.copy(), vertices=np.concatenate(out_parts))
+    # signed volume per component, from a fan triangulation of each cycle
+    p0 = points[oriented.vertices[oriented.offsets[:-1]]]
+    vol = np.zeros(nf)
+    for L in np.unique(lengths):
+        sel = np.flatnonzero(lengths == L)
+        base = oriented.offsets[sel]
+        for j in range(1, L - 1):
+            p1 = points[oriented.vertices[base + j]]
+            p2 = points[oriented.vertices[base + j + 1]]
+            vol[sel] += np.einsum("ij,ij->i", p0[sel], np.cross(p1, p2))
+    comp_vol = np.bincount(labels, weights=vol, minlength=ncomp)
+    neg = comp_vol[labels] < 0
+    if neg.any():
+        parts = []
+        for i in range(nf):
+            c = oriented.cycle(i)
+            parts.append(np.r_[c[0], c[:0:-1]] if neg[i] else c)
+        oriented = CycleSet(offsets=oriented.offsets, vertices=np.concatenate(parts))
+    return oriented, orientable
+
+
+def _less(x: float, y: float, rtol: float) -> int:
+    """-1, 0 or 1: compare with a relative tie tolerance."""
+    if abs(x - y) <= rtol * max(abs(x), abs(y)):
+        return 0
+    return -1 if x < y else 1
+
+
+def _area(points, a, b, c):
+    return 0.5 * np.linalg.norm(np.cross(points[b] - points[a], points[c] - points[a]), axis=-1)
+
+
+def _triangulate_polygon(points, cyc, forbidden: set, rtol: float):
+    """Minimum-area triangulation of one cycle avoiding ``forbidden`` diagonals."""
+    L = cyc.shape[0]
+    if L == 3:
+        return [tuple(int(v) for v in cyc)]
+    inf = float("inf")
+    cost = [[0.0] * L for _ in range(L)]
+    tie = [[0.0] * L for _ in range(L)]
+    split = [[-1] * L for _ in range(L)]
+
+    def allowed(i, j):
+        if j - i == 1 or (i == 0 and j == L - 1):
+            return True
+        a, b = int(cyc[i]), int(cyc[j])
+        return (min(a, b), max(a, b)) not in forbidden
+
+    for span in range(2, L):
+        for i in range(0, L - span):
+            j = i + span
+            best_c, best_t = inf, inf
+            if not allowed(i, j):
+                cost[i][j] = inf
+                continue
+            for m in range(i + 1, j):
+                if cost[i][m] == inf or cost[m][j] == inf:
+                    continue
+                area = float(_area(points, cyc[i], cyc[m], cyc[j]))
+                c = cost[i][m] + cost[m][j] + area
+                diag = tie[i][m] + tie[m][j]
+                if m - i > 1:
+                    diag += float(np.linalg.norm(points[cyc[i]] - points[cyc[m]]))
+                if j - m > 1:
+                    diag += float(np.linalg.norm(points[cyc[m]] - points[cyc[j]]))
+                cmp = _less(c, best_c, rtol) if best_c < inf else -1
+                if cmp == 0:
+                    cmp = _less(diag, best_t, rtol)
+                if cmp < 0:  # equal on both: the earlier split m wins
+                    best_c, best_t = c, diag
+                    cost[i][j] = c
+                    tie[i][j] = diag
+                    split[i][j] = m
+            if best_c == inf:
+                cost[i][j] = inf
+    if cost[0][L - 1] == inf:
+        # every diagonal choice is blocked: fall back to a fan from the first vertex
+        return [(int(cyc[0]), int(cyc[j]), int(cyc[j + 1])) for j in range(1, L - 1)]
+    out = []
+    stack = [(0, L - 1)]
+    while stack:
+        i, j = stack.pop()
+        if j - i < 2:
+            continue
+        m = split[i][j]
+        out.append((int(cyc[i]), int(cyc[m]), int(cyc[j])))
+        stack.append((i, m))
+        stack.append((m, j))
+    return out
+
+
+def triangulate(points, faces: CycleSet, *, rtol: float = 1e-9) -> Triangulation:
+    """Triangulate(◇): line 4 of Algorithm 1, triangles with disjoint interiors.
+
+    Parameters
+    ----------
+    points : (n, 3) array_like of float
+        The samples.
+    faces : CycleSet
+        Selected face cycles (:attr:`FaceSelection.faces`).
+    rtol : float
+        Relative tolerance for area ties (see :mod:`sr33.tolerance`).
+
+    Returns
+    -------
+    Triangulation
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sr33 import triangulate
+    >>> from sr33.cycles import CycleSet
+    >>> sq = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    >>> faces = CycleSet(np.array([0, 4]), np.array([0, 1, 2, 3]))
+    >>> triangulate(sq, faces).triangles.shape
+    (2, 3)
+    """
+    pts = as_points(points)
+    if not isinstance(faces, CycleSet):
+        raise InputError(f"faces must be a CycleSet, got {type(faces).__name__}")
+    if len(faces) and (faces.vertices.min() < 0 or faces.vertices.max() >= pts.shape[0]):
+        raise InputError("faces index points out of range")
+    oriented, orientable = orient_cycles(pts, faces)
+    pairs, _ = cycle_edges(oriented.offsets, oriented.vertices)
+    forbidden = {(int(min(a, b)), int(max(a, b))) for a, b in pairs}
+    tris: list[tuple[int, int, int]] = []
+    owner: list[int] = []
+    lengths = oriented.lengths
+    # vectorized quads: the common case
+    for i in range(len(oriented)):
+        cyc = oriented.cycle(i)
+        if lengths[i] == 4:
+            a, b, c, d = (int(v) for v in cyc)
+            ac_ok = (min(a, c), max(a, c)) not in forbidden
+            bd_ok = (min(b, d), max(b, d)) not in forbidden
+            area_ac = float(_area(pts, a, b, c) + _area(pts, a, c, d))
+            area_bd = float(_area(pts, a, b, d) + _area(pts, b, c, d))
+            len_ac = float(np.linalg.norm(pts[a] - pts[c]))
+            len_bd = float(np.linalg.norm(pts[b] - pts[d]))
+            if ac_ok != bd_ok:
+                use_ac = ac_ok
+            else:
+                cmp = _less(area_ac, area_bd, rtol) or _less(len_ac, len_bd, rtol)
+                use_ac = cmp < 0 or (cmp == 0 and min(a, c) < min(b, d))
+            if use_ac:
+                new = [(a, b, c), (a, c, d)]
+                forbidden.add((min(a, c), max(a, c)))
+            else:
+                new = [(a, b, d), (b, c, d)]
+                forbidden.add((min(b, d), max(b, d)))
+        else:
+            new = _triangulate_polygon(pts, cyc, forbidden, rtol)
+            for t in new:
+                for x, y in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+                    forbidden.add((min(x, y), max(x, y)))
+        tris.extend(new)
+        owner.extend([i] * len(new))
+    tri = np.array(tris, dtype=np.int64).reshape(-1, 3)
+    return Triangulation(
+        triangles=tri, face_of_triangle=np.array(owner, dtype=np.int64), orientable=orientable
+    )
