@@ -52,7 +52,7 @@ from scipy import sparse
 from scipy.sparse import csgraph
 
 from ._progress import bar
-from ._validate import InputError, as_points, as_edges
+from ._validate import InputError, as_edges, as_points
 from .cycles import CycleSet
 from .graph import cycle_edges, lookup_edges
 from .tolerance import DEFAULT, Tolerance
@@ -119,10 +119,25 @@ def _cycle_geometry(points, cs: CycleSet):
     return cen, flat
 
 
-def _rank(cs: CycleSet, flat: np.ndarray, rtol: float) -> np.ndarray:
-    """Rank of every cycle: length, then flatness, then canonical order."""
-    q = np.round(flat / max(rtol, 1e-300) * 1e-3)  # flatness to ~1e-6 relative
-    order = np.lexsort((np.arange(len(cs)), q, cs.lengths))
+def _cycle_area(points, cs: CycleSet, centroid) -> np.ndarray:
+    """Area of every cycle's fan from its centroid (label-free, rotation-free)."""
+    pairs, owner = cycle_edges(cs.offsets, cs.vertices)
+    c = centroid[owner]
+    tri = 0.5 * np.linalg.norm(np.cross(points[pairs[:, 0]] - c, points[pairs[:, 1]] - c), axis=1)
+    return np.bincount(owner, weights=tri, minlength=len(cs))
+
+
+def _rank(cs: CycleSet, area: np.ndarray, flat: np.ndarray) -> np.ndarray:
+    """Rank of every cycle: length, then area, then flatness, then canonical order.
+
+    Area and flatness are compared after rounding to 1e-6 of the median
+    cycle area (resp. absolutely), so that rounding noise from a rigid motion
+    does not reorder tied cycles; exact ties fall to the canonical order.
+    """
+    scale = float(np.median(area)) if area.shape[0] else 1.0
+    qa = np.round(area / (scale * 1e-6 if scale > 0 else 1.0))
+    qf = np.round(flat * 1e6)
+    order = np.lexsort((np.arange(len(cs)), qf, qa, cs.lengths))
     rank = np.empty(len(cs), dtype=np.int64)
     rank[order] = np.arange(len(cs))
     return rank
@@ -353,20 +368,17 @@ def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
         return True
 
     def choose():
-        best = None
-        for e in edges:
-            if rem[e] >= 2 and cnt[e] < 2:
-                key = (0 if cnt[e] == 1 else 1, rem[e], e)
-                if best is None or key < best[0]:
-                    best = (key, e)
-        if best is None:
-            for c in comp:
-                if x[c] == -1:
-                    return c
-            return None
-        e = best[1]
-        und = [int(c) for c in prob.cycles_at_edge(e) if int(c) in x and x[int(c)] == -1]
-        return min(und, key=lambda c: rank[c])
+        # the best-ranked undecided cycle on an edge that still needs one use,
+        # else the best-ranked undecided cycle: decisions follow geometry only
+        pick = None
+        for c in comp:  # comp is sorted by rank
+            if x[c] != -1:
+                continue
+            if pick is None:
+                pick = c
+            if any(cnt[int(e)] == 1 for e in prob.cycle_edge_ids[c]):
+                return c
+        return pick
 
     def set_and_propagate(c, val):
         qe: list[int] = []
@@ -415,7 +427,7 @@ def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
     def search():
         c = choose()
         if c is None:
-            return _all_attached([c for c in comp if x[c] == 1]) if has_fixed else True
+            return not has_fixed or _all_attached([d for d in comp if x[d] == 1])
         for val in (1, 0):
             mark = len(trail)
             if set_and_propagate(c, val) and search():
@@ -430,6 +442,7 @@ def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
     if ok:
         for c in comp:
             state[c] = 1 if x[c] == 1 else 0
+    return ok, counter[0]
     return ok, counter[0]
 
 
@@ -534,7 +547,7 @@ def backtracking(
     prob = _Problem(cycles, e, n)
     prob._offsets = cycles.offsets
     centroid, flat = _cycle_geometry(pts, cycles)
-    rank = _rank(cycles, flat, tolerance.rtol)
+    rank = _rank(cycles, _cycle_area(pts, cycles, centroid), flat)
     folds = _fold_pairs(pts, e, prob.inc_edge, prob.inc_cycle, centroid, tolerance.fold_degrees)
     conflicts: dict[int, list[int]] = {}
     for a, b in folds:
@@ -554,7 +567,10 @@ def backtracking(
     if free_idx.shape[0]:
         inc = free[prob.inc_cycle]
         b = sparse.csr_matrix(
-            (np.ones(int(inc.sum()), dtype=np.int8), (prob.inc_cycle[inc], prob.inc_edge[inc] + nc)),
+            (
+                np.ones(int(inc.sum()), dtype=np.int8),
+                (prob.inc_cycle[inc], prob.inc_edge[inc] + nc),
+            ),
             shape=(nc + e.shape[0], nc + e.shape[0]),
         )
         ncomp, labels = csgraph.connected_components(b, directed=False)

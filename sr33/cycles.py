@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _kernels
-from ._validate import as_edges, check_max_cycle_length, InputError
+from ._validate import InputError, as_edges, check_max_cycle_length
 from .graph import adjacency
 
 
@@ -55,7 +55,7 @@ class CycleSet:
         """All cycles as tuples (for tests and small inputs)."""
         return [tuple(int(v) for v in self.cycle(i)) for i in range(len(self))]
 
-    def subset(self, keep: np.ndarray) -> "CycleSet":
+    def subset(self, keep: np.ndarray) -> CycleSet:
         """The cycles whose indices (or boolean mask) are ``keep``."""
         idx = np.flatnonzero(keep) if np.asarray(keep).dtype == bool else np.asarray(keep)
         lengths = self.lengths[idx]

@@ -167,7 +167,8 @@ def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
     ext = p.suffix.lower()
     if ext not in MESH_FORMATS:
         raise WriteError(
-            f"{p}: unsupported output format {ext or '(none)'}; use one of {', '.join(MESH_FORMATS)}"
+            f"{p}: unsupported output format {ext or '(none)'}; "
+            f"use one of {', '.join(MESH_FORMATS)}"
         )
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
@@ -189,7 +190,9 @@ def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
             try:
                 import pyvista as pv
             except ImportError:
-                raise WriteError(f"{p}: writing .vtp needs PyVista: pip install 'sr33[vtk]'") from None
+                raise WriteError(
+                    f"{p}: writing .vtp needs PyVista: pip install 'sr33[vtk]'"
+                ) from None
             faces = np.hstack([np.full((t.shape[0], 1), 3, dtype=np.int64), t]).ravel()
             pv.PolyData(v, faces).save(tmp, binary=True)
         elif ext == ".obj":

@@ -1,0 +1,87 @@
+"""Slow, obviously correct references for the kernels (straight from the definitions)."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+from scipy.sparse import csgraph, csr_matrix
+
+
+def naive_neighbourhoods(points: np.ndarray, k: int, rtol: float) -> list[set[int]]:
+    """N(u; k): u, its k nearest, and every sample tied with the k-th (Section 1.2)."""
+    n = points.shape[0]
+    out = []
+    for u in range(n):
+        d = np.sqrt(((points - points[u]) ** 2).sum(axis=1))
+        others = np.sort(np.delete(d, u))
+        dk = others[k - 1]
+        out.append({u} | {v for v in range(n) if v != u and d[v] <= dk * (1 + rtol)})
+    return out
+
+
+def naive_rng_of(points: np.ndarray, members, rtol: float) -> set[tuple[int, int]]:
+    """RNG of a set of samples: ab is an edge iff no c lies strictly in the open lune."""
+    members = sorted(members)
+    edges = set()
+    for a, b in itertools.combinations(members, 2):
+        dab = np.linalg.norm(points[a] - points[b])
+        blocked = False
+        for c in members:
+            if c in (a, b):
+                continue
+            dac = np.linalg.norm(points[a] - points[c])
+            dbc = np.linalg.norm(points[b] - points[c])
+            if max(dac, dbc) < (1 - rtol) * dab:
+                blocked = True
+                break
+        if not blocked:
+            edges.add((a, b))
+    return edges
+
+
+def naive_localized_rng(points: np.ndarray, k: int, rtol: float) -> set[tuple[int, int]]:
+    """Algorithm 2 literally: the union of the RNGs of all N(u; k)."""
+    out: set[tuple[int, int]] = set()
+    for nb in naive_neighbourhoods(points, k, rtol):
+        out |= naive_rng_of(points, nb, rtol)
+    return out
+
+
+def naive_isometric_cycles(edges, n: int, max_len: int) -> set[tuple[int, ...]]:
+    """Every simple cycle up to max_len whose cycle distances equal graph distances."""
+    adj: dict[int, set[int]] = {v: set() for v in range(n)}
+    for a, b in edges:
+        adj[a].add(b)
+        adj[b].add(a)
+    rows = [a for a, b in edges] + [b for a, b in edges]
+    cols = [b for a, b in edges] + [a for a, b in edges]
+    g = csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+    dist = csgraph.shortest_path(g, unweighted=True, directed=False)
+    found: set[tuple[int, ...]] = set()
+
+    def extend(path):
+        if len(path) > max_len:
+            return
+        last = path[-1]
+        for y in adj[last]:
+            if y == path[0] and len(path) >= 3:
+                cyc = tuple(path)
+                if cyc[1] < cyc[-1]:
+                    found.add(cyc)
+            elif y > path[0] and y not in path:
+                extend(path + [y])
+
+    for s in range(n):
+        extend([s])
+    iso = set()
+    for cyc in found:
+        L = len(cyc)
+        ok = all(
+            dist[cyc[i], cyc[j]] == min(abs(i - j), L - abs(i - j))
+            for i in range(L)
+            for j in range(i + 1, L)
+        )
+        if ok:
+            iso.add(cyc)
+    return iso
