@@ -228,3 +228,98 @@ def isometric_cycles(indptr, indices, max_len):
         for q in range(cnt0):
             dist0[visited[q]] = -1
     return offs[: nc + 1].copy(), verts[: offs[nc]].copy()
+
+
+@njit(cache=True)
+def _find(parent, a):
+    while parent[a] != a:
+        parent[a] = parent[parent[a]]
+        a = parent[a]
+    return a
+
+
+@njit(cache=True)
+def neighbourhood_disks(
+    nb_indptr, nb_indices, cyc_offsets, cyc_vertices, cyc_edges, vc_indptr, vc_indices, n_edges
+):
+    """Euler characteristic and component count of the faces inside each N(u; k).
+
+    The faces inside N(u; k) are the cycles all of whose vertices belong to
+    it (the combinatorial stand-in for Conv(N(u; k)) ∩ P'); components are
+    counted through shared vertices.  Returns
+    ``(chi, comps, nfaces)``, each (n,) int64; a disk has ``chi == 1`` and
+    ``comps == 1``.
+    """
+    n = nb_indptr.shape[0] - 1
+    nc = cyc_offsets.shape[0] - 1
+    member = np.zeros(n, dtype=np.bool_)
+    vseen = np.zeros(n, dtype=np.bool_)
+    eowner = -np.ones(n_edges, dtype=np.int64)
+    vowner = -np.ones(n, dtype=np.int64)
+    cmark = np.zeros(nc, dtype=np.bool_)
+    parent = np.arange(nc)
+    chi = np.zeros(n, dtype=np.int64)
+    comps = np.zeros(n, dtype=np.int64)
+    nfaces = np.zeros(n, dtype=np.int64)
+    inside = np.empty(nc, dtype=np.int64)
+    for u in range(n):
+        lo = nb_indptr[u]
+        hi = nb_indptr[u + 1]
+        for q in range(lo, hi):
+            member[nb_indices[q]] = True
+        ni = 0
+        for q in range(lo, hi):
+            v = nb_indices[q]
+            for t in range(vc_indptr[v], vc_indptr[v + 1]):
+                c = vc_indices[t]
+                if cmark[c]:
+                    continue
+                cmark[c] = True
+                ok = True
+                for z in range(cyc_offsets[c], cyc_offsets[c + 1]):
+                    if not member[cyc_vertices[z]]:
+                        ok = False
+                        break
+                if ok:
+                    inside[ni] = c
+                    ni += 1
+        # reset marks of all touched cycles
+        for q in range(lo, hi):
+            v = nb_indices[q]
+            for t in range(vc_indptr[v], vc_indptr[v + 1]):
+                cmark[vc_indices[t]] = False
+        nv = 0
+        ne = 0
+        for i in range(ni):
+            c = inside[i]
+            parent[c] = c
+        ncomp = ni
+        for i in range(ni):
+            c = inside[i]
+            for z in range(cyc_offsets[c], cyc_offsets[c + 1]):
+                v = cyc_vertices[z]
+                if not vseen[v]:
+                    vseen[v] = True
+                    vowner[v] = c
+                    nv += 1
+                else:
+                    ra = _find(parent, vowner[v])
+                    rb = _find(parent, c)
+                    if ra != rb:
+                        parent[ra] = rb
+                        ncomp -= 1
+                e = cyc_edges[z]
+                if eowner[e] < 0:
+                    eowner[e] = c
+                    ne += 1
+        for i in range(ni):
+            c = inside[i]
+            for z in range(cyc_offsets[c], cyc_offsets[c + 1]):
+                vseen[cyc_vertices[z]] = False
+                eowner[cyc_edges[z]] = -1
+        for q in range(lo, hi):
+            member[nb_indices[q]] = False
+        chi[u] = nv - ne + ni
+        comps[u] = ncomp
+        nfaces[u] = ni
+    return chi, comps, nfaces

@@ -51,10 +51,12 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
+from . import _kernels
 from ._progress import bar
 from ._validate import InputError, as_edges, as_points
 from .cycles import CycleSet
 from .graph import cycle_edges, lookup_edges
+from .rng import k_neighbourhoods
 from .tolerance import DEFAULT, Tolerance
 
 
@@ -82,6 +84,16 @@ class FaceSelection:
         How many of them fell back to the greedy pass.
     assignments : int
         Total search assignments made (a measure of the work done).
+    non_disk_neighbourhoods : (r,) int64
+        Samples u for which the faces lying wholly inside N(u; k) do not form
+        one disk (Euler characteristic 1, connected): the combinatorial form
+        of the success condition "Conv(N(u; k)) ∩ P' is a disk".  Only
+        computed when ``k`` is given (else empty).  It is an indicator, not
+        part of ``success``: a face with vertices outside N(u; k) (a large
+        face at a cone tip) leaves a hole in this stand-in that the convex
+        hull would cover.
+    notes : tuple of str
+        Human-readable remarks (overloaded edges, empty input).
     """
 
     faces: CycleSet
@@ -92,6 +104,7 @@ class FaceSelection:
     components: int
     fallback_components: int
     assignments: int
+    non_disk_neighbourhoods: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64))
     notes: tuple[str, ...] = field(default=())
 
 
@@ -494,6 +507,7 @@ def backtracking(
     cycles: CycleSet,
     *,
     tolerance: Tolerance = DEFAULT,
+    k: int | None = None,
     budget: int = 20000,
     quiet: bool = True,
 ) -> FaceSelection:
@@ -516,6 +530,9 @@ def backtracking(
         Candidate cycles, normally from :func:`trivial_isometric_cycles`.
     tolerance : Tolerance
         ``fold_degrees`` decides which neighbouring cycles fold onto each other.
+    k : int, optional
+        Neighbourhood size; when given, the neighbourhood form of the success
+        condition is evaluated (``non_disk_neighbourhoods``).
     budget : int
         Maximum assignments of the strict search per component.
     quiet : bool
@@ -524,6 +541,16 @@ def backtracking(
     Returns
     -------
     FaceSelection
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sr33 import backtracking, localized_rng, trivial_isometric_cycles
+    >>> tet = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]], float)
+    >>> g = localized_rng(tet, 3).edges
+    >>> sel = backtracking(tet, g, trivial_isometric_cycles(g, 4))
+    >>> len(sel.faces), sel.success, sel.open_edges.shape
+    (4, True, (0, 2))
     """
     pts = as_points(points)
     n = pts.shape[0]
@@ -623,6 +650,27 @@ def backtracking(
             unresolved.append(v)
     unresolved_arr = np.array(unresolved, dtype=np.int64)
     success = over == 0 and unresolved_arr.shape[0] == 0 and fallback == 0
+    non_disk = np.empty(0, dtype=np.int64)
+    if k is not None and len(faces):
+        nb = k_neighbourhoods(pts, k, tolerance=tolerance)
+        f_pairs, f_owner = cycle_edges(faces.offsets, faces.vertices)
+        f_eid = lookup_edges(e, f_pairs, n)
+        vc = sparse.csr_matrix(
+            (np.ones(f_owner.shape[0], dtype=np.int8), (faces.vertices, f_owner)),
+            shape=(n, len(faces)),
+        )
+        vc.sort_indices()
+        chi, ncomp, _ = _kernels.neighbourhood_disks(
+            nb.indptr,
+            nb.indices,
+            faces.offsets,
+            faces.vertices,
+            f_eid,
+            vc.indptr.astype(np.int64),
+            vc.indices.astype(np.int64),
+            e.shape[0],
+        )
+        non_disk = np.flatnonzero((chi != 1) | (ncomp != 1)).astype(np.int64)
     notes = []
     if over:
         notes.append(f"{over} edges used more than twice")
@@ -635,5 +683,6 @@ def backtracking(
         components=len(comps),
         fallback_components=fallback,
         assignments=total,
+        non_disk_neighbourhoods=non_disk,
         notes=tuple(notes),
     )

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -113,7 +114,10 @@ def read_mesh(path) -> tuple[np.ndarray, np.ndarray]:
         else:
             import meshio
 
-            m = meshio.read(p)
+            with warnings.catch_warnings():
+                # meshio's STL reader overflows a uint32 size check (harmless)
+                warnings.simplefilter("ignore", RuntimeWarning)
+                m = meshio.read(p)
             v = np.asarray(m.points, dtype=np.float64)
             if v.ndim != 2 or v.shape[1] < 3:
                 raise ReadError(f"{p}: vertices must be 3D")
@@ -200,12 +204,17 @@ def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
                 fh.write("# written by sr33\n")
                 np.savetxt(fh, v, fmt="v %.17g %.17g %.17g")
                 np.savetxt(fh, t + 1, fmt="f %d %d %d")
+        elif ext == ".ply":
+            _write_ply(tmp, v, t)
+        elif ext == ".off":
+            with open(tmp, "w", encoding="ascii") as fh:
+                fh.write(f"OFF\n{v.shape[0]} {t.shape[0]} 0\n")
+                np.savetxt(fh, v, fmt="%.17g %.17g %.17g")
+                np.savetxt(fh, t, fmt="3 %d %d %d")
         else:
             import meshio
 
-            fmt = {".ply": "ply", ".off": "off", ".stl": "stl"}[ext]
-            # 32-bit indices: what PLY readers expect (and no meshio warning)
-            meshio.write_points_cells(tmp, v, [("triangle", t.astype(np.int32))], file_format=fmt)
+            meshio.write_points_cells(tmp, v, [("triangle", t.astype(np.int32))], file_format="stl")
         os.replace(tmp, p)
     except WriteError:
         _unlink(tmp)
@@ -217,6 +226,24 @@ def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
         _unlink(tmp)
         raise
     return p
+
+
+def _write_ply(path: str, v: np.ndarray, t: np.ndarray) -> None:
+    """Binary little-endian PLY, no timestamp (meshio's writer adds one)."""
+    header = (
+        "ply\nformat binary_little_endian 1.0\ncomment written by sr33\n"
+        f"element vertex {v.shape[0]}\n"
+        "property double x\nproperty double y\nproperty double z\n"
+        f"element face {t.shape[0]}\n"
+        "property list uchar int vertex_indices\nend_header\n"
+    )
+    faces = np.empty(t.shape[0], dtype=[("n", "u1"), ("idx", "<i4", (3,))])
+    faces["n"] = 3
+    faces["idx"] = t
+    with open(path, "wb") as fh:
+        fh.write(header.encode("ascii"))
+        fh.write(v.astype("<f8").tobytes())
+        fh.write(faces.tobytes())
 
 
 def _unlink(path: str) -> None:

@@ -43,11 +43,19 @@ class Reconstruction:
     face_cycles : CycleSet
         The selected 2-basis (Algorithm 4) before triangulation.
     success : bool
-        Whether the backtracking met its success condition everywhere.
+        Whether the backtracking met its success condition everywhere (no
+        edge used more than twice, every sample's link a disk, no fallback)
+        and the output is orientable.
+    orientable : bool
+        Whether the face cycles could be oriented coherently (a closed
+        non-orientable output cannot be embedded, so it is a failure).
     open_edges : (p, 2) int64
         Edges of the face cycles used once (the boundary, or failures).
     unresolved_samples : (q,) int64
         Samples whose face-cycle link is not a disk or that no face cycle used.
+    non_disk_neighbourhoods : (r,) int64
+        Samples whose neighbourhood's faces do not form a disk (see
+        :class:`sr33.FaceSelection`; an indicator).
     coned_samples : (s,) int64
         Samples attached by cones at the end (Section 5).
     fallback_components : int
@@ -67,8 +75,10 @@ class Reconstruction:
     candidate_cycles: int
     face_cycles: CycleSet
     success: bool
+    orientable: bool
     open_edges: np.ndarray
     unresolved_samples: np.ndarray
+    non_disk_neighbourhoods: np.ndarray
     coned_samples: np.ndarray
     fallback_components: int
     timings: dict[str, float] = field(default_factory=dict)
@@ -133,9 +143,12 @@ def reconstruct(
     with timed("isometric_cycles", timings):
         cycles = trivial_isometric_cycles(rng.edges, pts.shape[0], max_length=max_cycle_length)
     with timed("backtracking", timings):
-        sel = backtracking(pts, rng.edges, cycles, tolerance=tolerance, budget=budget, quiet=quiet)
+        sel = backtracking(
+            pts, rng.edges, cycles, tolerance=tolerance, k=k, budget=budget, quiet=quiet
+        )
     with timed("triangulate", timings):
-        tri = triangulate(pts, sel.faces, rtol=tolerance.rtol).triangles
+        tr = triangulate(pts, sel.faces, rtol=tolerance.rtol)
+        tri = tr.triangles
     with timed("cones", timings):
         if tri.shape[0]:
             tri, coned = attach_cones(pts, tri)
@@ -157,9 +170,11 @@ def reconstruct(
         rng_edges=rng_edges,
         candidate_cycles=len(cycles),
         face_cycles=faces,
-        success=bool(sel.success),
+        success=bool(sel.success and tr.orientable),
+        orientable=bool(tr.orientable),
         open_edges=open_edges,
         unresolved_samples=np.sort(relabel[sel.unresolved_samples]),
+        non_disk_neighbourhoods=np.sort(relabel[sel.non_disk_neighbourhoods]),
         coned_samples=np.sort(relabel[coned]),
         fallback_components=sel.fallback_components,
         timings=timings,

@@ -126,6 +126,12 @@ def _less(x: float, y: float, rtol: float) -> int:
     return -1 if x < y else 1
 
 
+def _cmp(x: np.ndarray, y: np.ndarray, rtol: float) -> np.ndarray:
+    """Elementwise -1, 0, 1 comparison with a relative tie tolerance."""
+    tie = np.abs(x - y) <= rtol * np.maximum(np.abs(x), np.abs(y))
+    return np.where(tie, 0, np.where(x < y, -1, 1))
+
+
 def _area(points, a, b, c):
     return 0.5 * np.linalg.norm(np.cross(points[b] - points[a], points[c] - points[a]), axis=-1)
 
@@ -222,40 +228,58 @@ def triangulate(points, faces: CycleSet, *, rtol: float = 1e-9) -> Triangulation
         raise InputError("faces index points out of range")
     oriented, orientable = orient_cycles(pts, faces)
     pairs, _ = cycle_edges(oriented.offsets, oriented.vertices)
-    forbidden = {(int(min(a, b)), int(max(a, b))) for a, b in pairs}
-    tris: list[tuple[int, int, int]] = []
-    owner: list[int] = []
+    n = pts.shape[0]
     lengths = oriented.lengths
-    # vectorized quads: the common case
-    for i in range(len(oriented)):
-        cyc = oriented.cycle(i)
-        if lengths[i] == 4:
-            a, b, c, d = (int(v) for v in cyc)
-            ac_ok = (min(a, c), max(a, c)) not in forbidden
-            bd_ok = (min(b, d), max(b, d)) not in forbidden
-            area_ac = float(_area(pts, a, b, c) + _area(pts, a, c, d))
-            area_bd = float(_area(pts, a, b, d) + _area(pts, b, c, d))
-            len_ac = float(np.linalg.norm(pts[a] - pts[c]))
-            len_bd = float(np.linalg.norm(pts[b] - pts[d]))
-            if ac_ok != bd_ok:
-                use_ac = ac_ok
-            else:
-                cmp = _less(area_ac, area_bd, rtol) or _less(len_ac, len_bd, rtol)
-                use_ac = cmp < 0 or (cmp == 0 and min(a, c) < min(b, d))
-            if use_ac:
-                new = [(a, b, c), (a, c, d)]
-                forbidden.add((min(a, c), max(a, c)))
-            else:
-                new = [(a, b, d), (b, c, d)]
-                forbidden.add((min(b, d), max(b, d)))
-        else:
-            new = _triangulate_polygon(pts, cyc, forbidden, rtol)
-            for t in new:
-                for x, y in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
-                    forbidden.add((min(x, y), max(x, y)))
-        tris.extend(new)
-        owner.extend([i] * len(new))
-    tri = np.array(tris, dtype=np.int64).reshape(-1, 3)
-    return Triangulation(
-        triangles=tri, face_of_triangle=np.array(owner, dtype=np.int64), orientable=orientable
-    )
+    tri_parts: list[np.ndarray] = []
+    own_parts: list[np.ndarray] = []
+    # triangles stay as they are
+    t3 = np.flatnonzero(lengths == 3)
+    if t3.shape[0]:
+        tri_parts.append(oriented.vertices[oriented.offsets[t3][:, None] + np.arange(3)])
+        own_parts.append(t3)
+    # quads, vectorized: the common case
+    q4 = np.flatnonzero(lengths == 4)
+    face_keys = np.unique(edge_keys(pairs[:, 0], pairs[:, 1], n))
+    sequential = [int(i) for i in np.flatnonzero(lengths > 4)]
+    if q4.shape[0]:
+        q = oriented.vertices[oriented.offsets[q4][:, None] + np.arange(4)]
+        a, b, c, d = q.T
+        k_ac = edge_keys(a, c, n)
+        k_bd = edge_keys(b, d, n)
+        ac_ok = ~np.isin(k_ac, face_keys)
+        bd_ok = ~np.isin(k_bd, face_keys)
+        area_ac = _area(pts, a, b, c) + _area(pts, a, c, d)
+        area_bd = _area(pts, a, b, d) + _area(pts, b, c, d)
+        len_ac = np.linalg.norm(pts[a] - pts[c], axis=1)
+        len_bd = np.linalg.norm(pts[b] - pts[d], axis=1)
+        cmp = _cmp(area_ac, area_bd, rtol)
+        cmp = np.where(cmp == 0, _cmp(len_ac, len_bd, rtol), cmp)
+        use_ac = (cmp < 0) | ((cmp == 0) & (np.minimum(a, c) < np.minimum(b, d)))
+        use_ac = np.where(ac_ok != bd_ok, ac_ok, use_ac)
+        diag = np.where(use_ac, k_ac, k_bd)
+        # a diagonal shared by two quads (or blocked both ways) is decided one by one
+        _, inv, cnt = np.unique(diag, return_inverse=True, return_counts=True)
+        clash = (cnt[inv] > 1) | ~(ac_ok | bd_ok)
+        ok = ~clash
+        t_ac = np.stack([np.stack([a, b, c], 1), np.stack([a, c, d], 1)], 1)
+        t_bd = np.stack([np.stack([a, b, d], 1), np.stack([b, c, d], 1)], 1)
+        tq = np.where(use_ac[:, None, None], t_ac, t_bd)[ok].reshape(-1, 3)
+        tri_parts.append(tq)
+        own_parts.append(np.repeat(q4[ok], 2))
+        face_keys = np.union1d(face_keys, diag[ok])
+        sequential += [int(i) for i in q4[clash]]
+    forbidden = set()
+    for key in face_keys.tolist():
+        forbidden.add((key // n, key % n))
+    for i in sorted(sequential):
+        new = _triangulate_polygon(pts, oriented.cycle(i), forbidden, rtol)
+        for t in new:
+            for x, y in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+                forbidden.add((min(x, y), max(x, y)))
+        tri_parts.append(np.array(new, dtype=np.int64).reshape(-1, 3))
+        own_parts.append(np.full(len(new), i, dtype=np.int64))
+    tri = np.concatenate(tri_parts).astype(np.int64) if tri_parts else np.empty((0, 3), np.int64)
+    owner = np.concatenate(own_parts).astype(np.int64) if own_parts else np.empty(0, np.int64)
+    order = np.argsort(owner, kind="stable")
+    tri, owner = tri[order], owner[order]
+    return Triangulation(triangles=tri, face_of_triangle=owner, orientable=orientable)

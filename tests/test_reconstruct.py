@@ -1,0 +1,98 @@
+"""reconstruct (Algorithm 1): invariance, determinism, small paper sets."""
+
+import numpy as np
+import pytest
+
+from samplers import cube_lattice
+from sr33 import reconstruct
+from sr33.io import read_points
+from tests.helpers import PAPER_SMALL, need, triangle_set
+from tests.strategies import rotation
+from validators import mesh_stats
+
+
+def figures(r):
+    return mesh_stats(r.triangles, r.vertices.shape[0]).as_dict()
+
+
+@pytest.mark.parametrize("name, euler", [("cone", 2), ("conebox", 2), ("cube", 2), ("cutcube", 0)])
+def test_small_paper_sets_are_closed_manifolds(name, euler):
+    pts = read_points(need(PAPER_SMALL / f"{name}.obj"))
+    r = reconstruct(pts, 16)
+    s = figures(r)
+    assert r.success
+    assert (s["open_edges"], s["overloaded_edges"], s["components"]) == (0, 0, 1)
+    assert s["euler"] == euler
+    assert s["used_vertices"] == len(pts)
+    assert s["edges"] == 3 * len(pts) - 3 * euler  # closed triangulation: E = 3V - 3χ
+
+
+def jittered(pts, scale, seed=0):
+    h = np.median(np.linalg.norm(np.diff(pts, axis=0), axis=1))
+    return pts + np.random.default_rng(seed).normal(size=pts.shape) * h * scale
+
+
+@pytest.fixture(params=["lattice", "jittered"])
+def cloud(request):
+    pts = read_points(need(PAPER_SMALL / "cube.obj"))
+    return pts if request.param == "lattice" else jittered(pts, 0.01)
+
+
+def test_shuffling_gives_the_same_triangles(cloud):
+    a = reconstruct(cloud, 16)
+    perm = np.random.default_rng(3).permutation(len(cloud))
+    b = reconstruct(cloud[perm], 16)
+    # vertex i of b is input point perm[i] (no duplicates): relabel to a's labels
+    assert triangle_set(b.triangles, perm) == triangle_set(a.triangles)
+    edges_a = {tuple(e) for e in a.rng_edges.tolist()}
+    edges_b = {tuple(sorted(e)) for e in perm[b.rng_edges].tolist()}
+    assert edges_a == edges_b
+
+
+@pytest.mark.parametrize(
+    "factor, shift", [(3.7, (0, 0, 0)), (1e-3, (5, -2, 1)), (250.0, (0.5, 0.5, 0.5))]
+)
+def test_scaling_and_translation_give_the_same_triangles(cloud, factor, shift):
+    a = reconstruct(cloud, 16)
+    b = reconstruct(cloud * factor + np.array(shift), 16)
+    assert triangle_set(b.triangles) == triangle_set(a.triangles)
+
+
+@pytest.mark.parametrize("seed", [1, 7, 42])
+def test_rotation_keeps_graph_and_topology_on_lattices(seed):
+    pts = read_points(need(PAPER_SMALL / "cube.obj"))
+    a = reconstruct(pts, 16)
+    b = reconstruct(pts @ rotation(seed).T + np.array([0.3, -2.0, 5.0]), 16)
+    assert np.array_equal(a.rng_edges, b.rng_edges)
+    assert figures(a) == figures(b)
+
+
+@pytest.mark.parametrize("seed", [1, 7, 42])
+def test_rotation_gives_the_same_triangles_without_exact_ties(seed):
+    pts = jittered(read_points(need(PAPER_SMALL / "cube.obj")), 0.01)
+    a = reconstruct(pts, 16)
+    b = reconstruct(pts @ rotation(seed).T + np.array([0.3, -2.0, 5.0]), 16)
+    assert triangle_set(a.triangles) == triangle_set(b.triangles)
+
+
+def test_two_runs_are_identical_arrays():
+    pts = cube_lattice(5)
+    a, b = reconstruct(pts, 12), reconstruct(pts, 12)
+    assert a.triangles.tobytes() == b.triangles.tobytes()
+    assert a.vertices.tobytes() == b.vertices.tobytes()
+
+
+def test_result_passes_through_every_sample_and_reports_steps():
+    pts = cube_lattice(4)
+    r = reconstruct(pts, 12)
+    np.testing.assert_array_equal(r.vertices, pts)  # first-occurrence order
+    assert np.unique(r.triangles).shape[0] == len(pts)
+    assert set(r.timings) >= {
+        "localized_rng",
+        "isometric_cycles",
+        "backtracking",
+        "triangulate",
+        "cones",
+    }
+    assert r.candidate_cycles >= len(r.face_cycles)
+    assert r.orientable and r.success
