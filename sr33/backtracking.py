@@ -56,7 +56,7 @@ from ._progress import bar
 from ._validate import InputError, as_edges, as_points
 from .cycles import CycleSet
 from .graph import cycle_edges, lookup_edges
-from .rng import k_neighbourhoods
+from .rng import Neighbourhoods, k_neighbourhoods
 from .tolerance import DEFAULT, Tolerance
 
 
@@ -172,18 +172,53 @@ def _fold_pairs(points, edges, inc_edge, inc_cycle, centroid, fold_degrees):
     cos_lim = np.cos(np.radians(fold_degrees))
     starts = np.flatnonzero(np.r_[True, e_sorted[1:] != e_sorted[:-1]])
     ends = np.r_[starts[1:], e_sorted.shape[0]]
-    pairs = []
-    multi = np.flatnonzero(ends - starts >= 2)
-    for g in multi:
+    size = ends - starts
+    # the common case, edges in exactly two cycles, vectorized
+    two = starts[size == 2]
+    hit = (w[two] * w[two + 1]).sum(axis=1) > cos_lim
+    pairs = [np.stack([c_sorted[two[hit]], c_sorted[two[hit] + 1]], axis=1)]
+    for g in np.flatnonzero(size >= 3):
         s, t = starts[g], ends[g]
         ww = w[s:t]
-        cosm = ww @ ww.T
-        ii, jj = np.nonzero(np.triu(cosm > cos_lim, 1))
-        for i, j in zip(ii, jj):
-            pairs.append((c_sorted[s + i], c_sorted[s + j]))
-    if not pairs:
+        ii, jj = np.nonzero(np.triu((ww @ ww.T) > cos_lim, 1))
+        pairs.append(np.stack([c_sorted[s + ii], c_sorted[s + jj]], axis=1))
+    out = np.concatenate(pairs).astype(np.int64)
+    if not out.shape[0]:
         return np.empty((0, 2), dtype=np.int64)
-    return np.unique(np.sort(np.array(pairs, dtype=np.int64), axis=1), axis=0)
+    return np.unique(np.sort(out, axis=1), axis=0)
+
+
+def links_are_disks(n: int, vertex, prev, nxt) -> np.ndarray:
+    """For every vertex, whether its link (corner pairs prev-next) is one path or cycle.
+
+    Vectorized over all vertices: link nodes are (vertex, neighbour) pairs,
+    each corner joins two of them; a link is a disk when every node has
+    degree <= 2 and the nodes form a single connected component.  Vertices
+    with no corner get False.
+    """
+    vertex = np.asarray(vertex, dtype=np.int64)
+    ok = np.zeros(n, dtype=bool)
+    if vertex.shape[0] == 0:
+        return ok
+    a = vertex * n + np.asarray(prev, dtype=np.int64)
+    b = vertex * n + np.asarray(nxt, dtype=np.int64)
+    keys, inv = np.unique(np.concatenate([a, b]), return_inverse=True)
+    m = vertex.shape[0]
+    ia, ib = inv[:m], inv[m:]
+    deg = np.bincount(inv, minlength=keys.shape[0])
+    node_vertex = keys // n
+    g = sparse.csr_matrix(
+        (np.ones(m, dtype=np.int8), (ia, ib)), shape=(keys.shape[0], keys.shape[0])
+    )
+    _, labels = csgraph.connected_components(g, directed=False)
+    comp_keys = np.unique(node_vertex * keys.shape[0] + labels)
+    comps = np.bincount(comp_keys // keys.shape[0], minlength=n)
+    bad_deg = np.zeros(n, dtype=bool)
+    bad_deg[node_vertex[deg > 2]] = True
+    loops = np.zeros(n, dtype=bool)
+    loops[vertex[np.asarray(prev) == np.asarray(nxt)]] = True
+    has = np.bincount(vertex, minlength=n) > 0
+    return has & (comps == 1) & ~bad_deg & ~loops
 
 
 def _link_is_disk(corners: list[tuple[int, int]]) -> bool:
@@ -508,6 +543,7 @@ def backtracking(
     *,
     tolerance: Tolerance = DEFAULT,
     k: int | None = None,
+    neighbourhoods: Neighbourhoods | None = None,
     budget: int = 20000,
     quiet: bool = True,
 ) -> FaceSelection:
@@ -533,6 +569,9 @@ def backtracking(
     k : int, optional
         Neighbourhood size; when given, the neighbourhood form of the success
         condition is evaluated (``non_disk_neighbourhoods``).
+    neighbourhoods : Neighbourhoods, optional
+        The N(u; k) already computed for these points with this ``k`` (as in
+        :attr:`LocalizedRNG.neighbourhoods`), to avoid recomputing them.
     budget : int
         Maximum assignments of the strict search per component.
     quiet : bool
@@ -636,23 +675,18 @@ def backtracking(
     open_edges = e[use == 1]
     over = int((use > 2).sum())
     sel_corner = selected[prob.corner_owner]
-    unresolved = []
-    cv = prob.corner_vertex[sel_corner]
-    cp = prob.corner_prev[sel_corner]
-    cn = prob.corner_next[sel_corner]
-    order = np.argsort(cv, kind="stable")
-    cv, cp, cn = cv[order], cp[order], cn[order]
-    starts = np.searchsorted(cv, np.arange(n))
-    stops = np.searchsorted(cv, np.arange(n), side="right")
-    for v in range(n):
-        s, t = starts[v], stops[v]
-        if s == t or not _link_is_disk(list(zip(cp[s:t].tolist(), cn[s:t].tolist()))):
-            unresolved.append(v)
-    unresolved_arr = np.array(unresolved, dtype=np.int64)
+    disk = links_are_disks(
+        n,
+        prob.corner_vertex[sel_corner],
+        prob.corner_prev[sel_corner],
+        prob.corner_next[sel_corner],
+    )
+    unresolved = np.flatnonzero(~disk)
+    unresolved_arr = unresolved.astype(np.int64)
     success = over == 0 and unresolved_arr.shape[0] == 0 and fallback == 0
     non_disk = np.empty(0, dtype=np.int64)
-    if k is not None and len(faces):
-        nb = k_neighbourhoods(pts, k, tolerance=tolerance)
+    if (k is not None or neighbourhoods is not None) and len(faces):
+        nb = neighbourhoods or k_neighbourhoods(pts, k, tolerance=tolerance)
         f_pairs, f_owner = cycle_edges(faces.offsets, faces.vertices)
         f_eid = lookup_edges(e, f_pairs, n)
         vc = sparse.csr_matrix(

@@ -144,7 +144,14 @@ def reconstruct(
         cycles = trivial_isometric_cycles(rng.edges, pts.shape[0], max_length=max_cycle_length)
     with timed("backtracking", timings):
         sel = backtracking(
-            pts, rng.edges, cycles, tolerance=tolerance, k=k, budget=budget, quiet=quiet
+            pts,
+            rng.edges,
+            cycles,
+            tolerance=tolerance,
+            k=k,
+            neighbourhoods=rng.neighbourhoods,
+            budget=budget,
+            quiet=quiet,
         )
     with timed("triangulate", timings):
         tr = triangulate(pts, sel.faces, rtol=tolerance.rtol)

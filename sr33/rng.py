@@ -146,5 +146,7 @@ def localized_rng(
             parts.append(_kernels.local_rng_pairs(pts, nb.indptr, nb.indices, shrink2, lo, hi))
             pbar.update(hi - lo)
     pairs = np.concatenate(parts) if parts else np.empty((0, 2), np.int64)
-    edges = np.unique(pairs, axis=0) if pairs.size else pairs.reshape(0, 2)
+    # 1-D keys are an order of magnitude faster to deduplicate than rows
+    keys = np.unique(pairs[:, 0] * n + pairs[:, 1])
+    edges = np.stack([keys // n, keys % n], axis=1)
     return LocalizedRNG(edges=np.ascontiguousarray(edges, dtype=np.int64), neighbourhoods=nb)
