@@ -140,17 +140,22 @@ def _cycle_area(points, cs: CycleSet, centroid) -> np.ndarray:
     return np.bincount(owner, weights=tri, minlength=len(cs))
 
 
-def _rank(cs: CycleSet, area: np.ndarray, flat: np.ndarray) -> np.ndarray:
-    """Rank of every cycle: length, then area, then flatness, then canonical order.
+def _rank(cs: CycleSet, area: np.ndarray, flat: np.ndarray, spread: np.ndarray) -> np.ndarray:
+    """Rank of every cycle: length, area, flatness, spread, then canonical order.
 
-    Area and flatness are compared after rounding to 1e-6 of the median
-    cycle area (resp. absolutely), so that rounding noise from a rigid motion
-    does not reorder tied cycles; exact ties fall to the canonical order.
+    Area, flatness and spread (distance of the cycle's centroid from the
+    centroid of all samples) are compared after rounding to 1e-6 relative,
+    so that rounding noise from a rigid motion does not reorder tied cycles.
+    All four keys are invariant under permutation, rigid motion and uniform
+    scaling; only cycles tied on all four fall to the canonical
+    (lexicographic) order, which is not rotation invariant.
     """
     scale = float(np.median(area)) if area.shape[0] else 1.0
     qa = np.round(area / (scale * 1e-6 if scale > 0 else 1.0))
     qf = np.round(flat * 1e6)
-    order = np.lexsort((np.arange(len(cs)), qf, qa, cs.lengths))
+    reach = float(spread.max()) if spread.shape[0] else 1.0
+    qs = np.round(spread / (reach * 1e-7 if reach > 0 else 1.0))
+    order = np.lexsort((np.arange(len(cs)), qs, qf, qa, cs.lengths))
     rank = np.empty(len(cs), dtype=np.int64)
     rank[order] = np.arange(len(cs))
     return rank
@@ -613,7 +618,8 @@ def backtracking(
     prob = _Problem(cycles, e, n)
     prob._offsets = cycles.offsets
     centroid, flat = _cycle_geometry(pts, cycles)
-    rank = _rank(cycles, _cycle_area(pts, cycles, centroid), flat)
+    spread = np.linalg.norm(centroid - pts.mean(axis=0), axis=1)
+    rank = _rank(cycles, _cycle_area(pts, cycles, centroid), flat, spread)
     folds = _fold_pairs(pts, e, prob.inc_edge, prob.inc_cycle, centroid, tolerance.fold_degrees)
     conflicts: dict[int, list[int]] = {}
     for a, b in folds:

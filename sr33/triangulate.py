@@ -10,7 +10,9 @@ A cycle of length L is triangulated by dynamic programming over its
 diagonals (O(L³), L <= max cycle length): minimum total area, never a
 diagonal that is already an edge of another face (it would be used three
 times).  Ties, such as the two diagonals of a planar square, are broken by
-the shorter diagonal, then by the canonical order of the samples.
+the shorter diagonal, then by the diagonal through the vertex nearest to the
+centroid of all samples (invariant under rigid motion and scaling), and only
+then by the canonical order of the samples.
 """
 
 from __future__ import annotations
@@ -252,8 +254,15 @@ def triangulate(points, faces: CycleSet, *, rtol: float = 1e-9) -> Triangulation
         area_bd = _area(pts, a, b, d) + _area(pts, b, c, d)
         len_ac = np.linalg.norm(pts[a] - pts[c], axis=1)
         len_bd = np.linalg.norm(pts[b] - pts[d], axis=1)
+        # ties (planar squares): the diagonal through the vertex nearest to
+        # the centroid of all samples, a rigid-motion invariant rule
+        g = pts.mean(axis=0)
+        r = np.linalg.norm(pts - g, axis=1)
+        near_ac = np.minimum(r[a], r[c])
+        near_bd = np.minimum(r[b], r[d])
         cmp = _cmp(area_ac, area_bd, rtol)
         cmp = np.where(cmp == 0, _cmp(len_ac, len_bd, rtol), cmp)
+        cmp = np.where(cmp == 0, _cmp(near_ac, near_bd, 1e3 * rtol), cmp)
         use_ac = (cmp < 0) | ((cmp == 0) & (np.minimum(a, c) < np.minimum(b, d)))
         use_ac = np.where(ac_ok != bd_ok, ac_ok, use_ac)
         diag = np.where(use_ac, k_ac, k_bd)
