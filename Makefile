@@ -27,6 +27,9 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python bench/run.py --data $(DATA) --out out/bench.json
 
+fuzz: $(STAMP)
+	HYPOTHESIS_PROFILE=deep $(BIN)/python -m pytest -q tests
+
 lint: $(STAMP)
 	$(BIN)/ruff check .
 

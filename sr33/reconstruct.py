@@ -18,6 +18,7 @@ from .backtracking import backtracking
 from .cones import attach_cones
 from .cycles import CycleSet, trivial_isometric_cycles
 from .rng import localized_rng
+from .selfcheck import check_faces_and_triangles, strict_default
 from .tolerance import DEFAULT, Tolerance
 from .triangulate import triangulate
 
@@ -93,6 +94,7 @@ def reconstruct(
     budget: int = 20000,
     tolerance: Tolerance = DEFAULT,
     quiet: bool = True,
+    strict: bool | None = None,
 ) -> Reconstruction:
     """Reconstruct a surface with sharp features from point samples (Algorithm 1).
 
@@ -111,6 +113,11 @@ def reconstruct(
         Tie and fold tolerances (:mod:`sr33.tolerance`).
     quiet : bool
         Hide progress bars.
+    strict : bool, optional
+        Run the expensive self-checks of :mod:`sr33.selfcheck` (edge use at
+        most two, one triangle fewer than sides per face, Euler
+        characteristic kept by the triangulation).  Defaults to the
+        ``SR33_STRICT`` environment variable (the test suite sets it).
 
     Returns
     -------
@@ -156,6 +163,9 @@ def reconstruct(
     with timed("triangulate", timings):
         tr = triangulate(pts, sel.faces, rtol=tolerance.rtol)
         tri = tr.triangles
+    if strict_default() if strict is None else strict:
+        with timed("self_checks", timings):
+            check_faces_and_triangles(sel.faces, tri, tr.face_of_triangle)
     with timed("cones", timings):
         if tri.shape[0]:
             tri, coned = attach_cones(pts, tri)

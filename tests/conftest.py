@@ -2,6 +2,9 @@
 
 import os
 
+# every reconstruction in the suite runs the expensive self-checks
+os.environ["SR33_STRICT"] = "1"
+
 from hypothesis import HealthCheck, settings
 
 settings.register_profile(

@@ -96,3 +96,17 @@ def test_result_passes_through_every_sample_and_reports_steps():
     }
     assert r.candidate_cycles >= len(r.face_cycles)
     assert r.orientable and r.success
+
+
+def test_strict_self_check_catches_a_broken_triangulation():
+    import pytest as _pytest
+
+    from sr33.cycles import CycleSet
+    from sr33.selfcheck import InternalError, check_faces_and_triangles
+
+    faces = CycleSet(np.array([0, 4]), np.array([0, 1, 2, 3]))
+    with _pytest.raises(InternalError, match="a face did not become length - 2 triangles"):
+        check_faces_and_triangles(faces, np.array([[0, 1, 2]]), np.array([0]))
+    two = CycleSet(np.array([0, 3, 6, 9]), np.array([0, 1, 2, 0, 1, 3, 0, 1, 4]))
+    with _pytest.raises(InternalError, match="an edge is used 3 times"):
+        check_faces_and_triangles(two, np.array([[0, 1, 2], [0, 1, 3], [0, 1, 4]]), np.arange(3))

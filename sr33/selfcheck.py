@@ -1,0 +1,58 @@
+"""Expensive self-checks of the pipeline's own invariants (the ``strict`` switch).
+
+These are not input validation: they verify that the steps kept the promises
+of Section 4 (Algorithm 4's invariant, Triangulate's disjoint interiors) on
+the result just computed, and raise :class:`InternalError` when they did
+not.  ``reconstruct(strict=True)`` runs them; the test suite turns them on
+for every reconstruction through the ``SR33_STRICT`` environment variable.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from .cycles import CycleSet
+from .graph import cycle_edges
+
+
+class InternalError(RuntimeError):
+    """A self-check of sr33 failed: a bug, please report it with the input."""
+
+
+def strict_default() -> bool:
+    """True when the environment variable ``SR33_STRICT`` is set to 1."""
+    return os.environ.get("SR33_STRICT", "") == "1"
+
+
+def _uses(pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    e = np.sort(pairs, axis=1)
+    return np.unique(e, axis=0, return_counts=True)
+
+
+def check_faces_and_triangles(
+    faces: CycleSet, triangles: np.ndarray, face_of_triangle: np.ndarray
+) -> None:
+    """Edge use <= 2 in the faces and the triangles; L - 2 triangles per face;
+    the triangles' Euler characteristic equals the faces'."""
+    if len(faces) == 0:
+        return
+    pairs, _ = cycle_edges(faces.offsets, faces.vertices)
+    fe, fc = _uses(pairs)
+    if fc.max() > 2:
+        raise InternalError(f"backtracking invariant broken: an edge is used {fc.max()} times")
+    per_face = np.bincount(face_of_triangle, minlength=len(faces))
+    if not np.array_equal(per_face, faces.lengths - 2):
+        raise InternalError("triangulate: a face did not become length - 2 triangles")
+    tp = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    te, tc = _uses(tp)
+    if tc.max() > 2:
+        raise InternalError(f"triangulate: an edge is used by {tc.max()} triangles")
+    v = np.unique(faces.vertices).shape[0]
+    chi_faces = v - fe.shape[0] + len(faces)
+    chi_tri = np.unique(triangles).shape[0] - te.shape[0] + triangles.shape[0]
+    if chi_faces != chi_tri:
+        raise InternalError(
+            f"triangulate changed the Euler characteristic from {chi_faces} to {chi_tri}"
+        )
