@@ -14,6 +14,8 @@ from __future__ import annotations
 import os
 import tempfile
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -161,26 +163,21 @@ def _read_vtp(p: Path):
     return v, f
 
 
-def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
-    """Write a triangle mesh atomically (temporary file, then rename).
-
-    The format follows the extension: ``.ply``, ``.obj``, ``.off``, ``.stl``
-    or ``.vtp``.  Same arrays give byte-identical files.
-    """
+@contextmanager
+def _atomic(path, formats: tuple[str, ...], what: str) -> Iterator[tuple[str, str]]:
+    """Yield ``(temporary path, extension)`` in the target's directory; on
+    success rename it over ``path``, on any failure remove it."""
     p = Path(path)
     ext = p.suffix.lower()
-    if ext not in MESH_FORMATS:
+    if ext not in formats:
         raise WriteError(
-            f"{p}: unsupported output format {ext or '(none)'}; "
-            f"use one of {', '.join(MESH_FORMATS)}"
+            f"{p}: unsupported {what} format {ext or '(none)'}; use one of {', '.join(formats)}"
         )
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
         raise WriteError(f"{p}: directory {parent} does not exist")
     if p.is_dir():
         raise WriteError(f"{p}: is a directory")
-    v = np.ascontiguousarray(vertices, dtype=np.float64)
-    t = np.ascontiguousarray(triangles, dtype=np.int64)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}.", suffix=ext, dir=parent)
     except OSError as exc:
@@ -190,15 +187,39 @@ def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
     os.umask(umask)
     os.chmod(tmp, 0o666 & ~umask)
     try:
+        yield tmp, ext
+        os.replace(tmp, p)
+    except WriteError:
+        _unlink(tmp)
+        raise
+    except OSError as exc:
+        _unlink(tmp)
+        raise WriteError(f"{p}: cannot write ({exc.strerror or exc})") from None
+    except BaseException:
+        _unlink(tmp)
+        raise
+
+
+def _pyvista(p):
+    try:
+        import pyvista as pv
+    except ImportError:
+        raise WriteError(f"{p}: writing .vtp needs PyVista: pip install 'sr33[vtk]'") from None
+    return pv
+
+
+def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
+    """Write a triangle mesh atomically (temporary file, then rename).
+
+    The format follows the extension: ``.ply``, ``.obj``, ``.off``, ``.stl``
+    or ``.vtp``.  Same arrays give byte-identical files.
+    """
+    v = np.ascontiguousarray(vertices, dtype=np.float64)
+    t = np.ascontiguousarray(triangles, dtype=np.int64)
+    with _atomic(path, MESH_FORMATS, "output") as (tmp, ext):
         if ext == ".vtp":
-            try:
-                import pyvista as pv
-            except ImportError:
-                raise WriteError(
-                    f"{p}: writing .vtp needs PyVista: pip install 'sr33[vtk]'"
-                ) from None
             faces = np.hstack([np.full((t.shape[0], 1), 3, dtype=np.int64), t]).ravel()
-            pv.PolyData(v, faces).save(tmp, binary=True)
+            _pyvista(path).PolyData(v, faces).save(tmp, binary=True)
         elif ext == ".obj":
             with open(tmp, "w", encoding="ascii") as fh:
                 fh.write("# written by sr33\n")
@@ -215,35 +236,68 @@ def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
             import meshio
 
             meshio.write_points_cells(tmp, v, [("triangle", t.astype(np.int32))], file_format="stl")
-        os.replace(tmp, p)
-    except WriteError:
-        _unlink(tmp)
-        raise
-    except OSError as exc:
-        _unlink(tmp)
-        raise WriteError(f"{p}: cannot write ({exc.strerror or exc})") from None
-    except BaseException:
-        _unlink(tmp)
-        raise
-    return p
+    return Path(path)
 
 
-def _write_ply(path: str, v: np.ndarray, t: np.ndarray) -> None:
+def write_points(path, points: np.ndarray, fields: dict[str, np.ndarray] | None = None) -> Path:
+    """Write a point list atomically: ``.ply``, ``.xyz``, ``.txt``, ``.npy``, ``.obj``, ``.vtp``.
+
+    ``fields`` (integer arrays, one value per point, e.g. scan-line ids) are
+    stored as extra vertex properties in PLY and VTP and ignored elsewhere.
+    """
+    v = np.ascontiguousarray(points, dtype=np.float64)
+    fields = {k: np.asarray(a, dtype=np.int32) for k, a in (fields or {}).items()}
+    with _atomic(path, (".ply", ".xyz", ".txt", ".npy", ".obj", ".vtp"), "point") as (tmp, ext):
+        if ext == ".ply":
+            _write_ply(tmp, v, None, fields)
+        elif ext in (".xyz", ".txt"):
+            np.savetxt(tmp, v, fmt="%.17g %.17g %.17g")
+        elif ext == ".npy":
+            with open(tmp, "wb") as fh:
+                np.save(fh, v)
+        elif ext == ".obj":
+            with open(tmp, "w", encoding="ascii") as fh:
+                fh.write("# written by sr33\n")
+                np.savetxt(fh, v, fmt="v %.17g %.17g %.17g")
+        else:
+            cloud = _pyvista(path).PolyData(v)
+            for k, a in fields.items():
+                cloud.point_data[k] = a
+            cloud.save(tmp, binary=True)
+    return Path(path)
+
+
+def write_text(path, text: str) -> Path:
+    """Write a JSON or text file atomically."""
+    with _atomic(path, (".json", ".txt"), "text") as (tmp, _):
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(text)
+    return Path(path)
+
+
+def _write_ply(path: str, v: np.ndarray, t: np.ndarray | None, fields=None) -> None:
     """Binary little-endian PLY, no timestamp (meshio's writer adds one)."""
-    header = (
-        "ply\nformat binary_little_endian 1.0\ncomment written by sr33\n"
-        f"element vertex {v.shape[0]}\n"
-        "property double x\nproperty double y\nproperty double z\n"
-        f"element face {t.shape[0]}\n"
-        "property list uchar int vertex_indices\nend_header\n"
-    )
-    faces = np.empty(t.shape[0], dtype=[("n", "u1"), ("idx", "<i4", (3,))])
-    faces["n"] = 3
-    faces["idx"] = t
+    fields = fields or {}
+    header = "ply\nformat binary_little_endian 1.0\ncomment written by sr33\n"
+    header += f"element vertex {v.shape[0]}\n"
+    header += "property double x\nproperty double y\nproperty double z\n"
+    header += "".join(f"property int {k}\n" for k in fields)
+    if t is not None:
+        header += f"element face {t.shape[0]}\nproperty list uchar int vertex_indices\n"
+    header += "end_header\n"
+    vdt = [("xyz", "<f8", (3,))] + [(k, "<i4") for k in fields]
+    verts = np.empty(v.shape[0], dtype=vdt)
+    verts["xyz"] = v
+    for k, a in fields.items():
+        verts[k] = a
     with open(path, "wb") as fh:
         fh.write(header.encode("ascii"))
-        fh.write(v.astype("<f8").tobytes())
-        fh.write(faces.tobytes())
+        fh.write(verts.tobytes())
+        if t is not None:
+            faces = np.empty(t.shape[0], dtype=[("n", "u1"), ("idx", "<i4", (3,))])
+            faces["n"] = 3
+            faces["idx"] = t
+            fh.write(faces.tobytes())
 
 
 def _unlink(path: str) -> None:
