@@ -8,10 +8,11 @@ a CadQuery shape:
   most transversally — the direction d minimising the area-weighted mean of
   ``|n · d|`` over the face — so that no face is missed or hit at a grazing
   angle (the top of a box swept along z would be);
-* planes of a family sit at ``t0 + j h`` along d, with t0 the shape's
-  bounding-box minimum, so neighbouring faces of one family share their scan
-  lines and a face bounded by a plane of the family starts its lattice on
-  that boundary;
+* planes of a family sit at ``t0 + j h_d`` along d, with t0 the shape's
+  bounding-box minimum and h_d the spacing nearest to h that divides the
+  shape's extent along d, so neighbouring faces of one family share their
+  scan lines and faces bounded by the extreme planes start and end their
+  lattice on that boundary;
 * along each section curve the samples are spaced by arc length, about
   ``r · h`` apart with both ends on the face boundary (``L / round(L / rh)``),
   giving a near-rectangular ``h × r·h`` lattice: the triangles of its
@@ -219,8 +220,30 @@ def _chains(edges, tol: float) -> list[tuple[list[tuple[Any, bool]], bool]]:
     return chains
 
 
-def _sample_chain(chain, closed: bool, step: float) -> np.ndarray:
-    """Points at equal arc-length steps (about ``step``) along a chain of edges."""
+def _sample_chain(chain, closed: bool, step: float, anchor: np.ndarray) -> np.ndarray:
+    """Samples along a chain of edges, about ``step`` apart.
+
+    A straight segment is sampled where its coordinate along its own
+    direction, measured from ``anchor`` (the shape's bounding-box minimum),
+    is a multiple of ``step`` (plus both ends): parallel scan lines
+    of a planar face then share one lattice, the rectangular lattice of
+    Figure 1, instead of staggered rows.  Any other chain is sampled at
+    equal arc-length steps from its start (for a closed section of a surface
+    of revolution: from the seam, so rows line up too).
+    """
+    if len(chain) == 1 and not closed and chain[0][0].geomType() == "LINE":
+        e = chain[0][0]
+        a = np.array(e.startPoint().toTuple())
+        b = np.array(e.endPoint().toTuple())
+        length = float(np.linalg.norm(b - a))
+        u = (b - a) / length
+        c0 = float((a - anchor) @ u)
+        first = math.ceil(c0 / step - 1e-9)
+        last = math.floor((c0 + length) / step + 1e-9)
+        s = np.arange(first, last + 1) * step - c0
+        s = s[(s > 1e-9 * length) & (s < length * (1 - 1e-9))]
+        s = np.concatenate([[0.0], s, [length]])
+        return a + s[:, None] * u
     lengths = np.array([e.Length() for e, _ in chain])
     total = float(lengths.sum())
     m = max(1, int(round(total / step)))
@@ -436,6 +459,10 @@ def scan(
     for fi, face in enumerate(faces):
         d = dirs[fam[fi]]
         t0 = float((corner @ d).min())
+        # the family's spacing divides the shape's extent along d, so the
+        # last plane meets the far side as the first meets the near side
+        extent = float((corner @ d).max()) - t0
+        hf = extent / max(1, round(extent / h)) if extent > 0 else h
         flo, fhi = _exact_bounds(face)
         fc = np.array(
             [
@@ -446,14 +473,14 @@ def scan(
             ]
         )
         proj = fc @ d
-        j0 = math.ceil((proj.min() - t0) / h)
-        j1 = math.floor((proj.max() - t0) / h)
+        j0 = math.ceil((proj.min() - t0) / hf - 1e-9)
+        j1 = math.floor((proj.max() - t0) / hf + 1e-9)
         for j in range(j0, j1 + 1):
-            t = t0 + j * h
+            t = t0 + j * hf
             origin = d * t
             edges = _section(face, tuple(origin), tuple(d))
             for chain, closed in _chains(edges, max(tol, 1e-9)):
-                p = _sample_chain(chain, closed, ratio * h)
+                p = _sample_chain(chain, closed, ratio * hf, lo)
                 pts.extend(p)
                 fids.extend([fi] * len(p))
                 line_ids.extend([line] * len(p))
