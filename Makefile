@@ -6,7 +6,7 @@ BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed
 DATA    ?= ../shared/datasets
 
-.PHONY: install demo test bench lint fuzz clean
+.PHONY: install demo test bench bench-compare lint fuzz clean
 
 install: $(STAMP)
 
@@ -29,6 +29,13 @@ bench: $(STAMP)
 
 fuzz: $(STAMP)
 	HYPOTHESIS_PROFILE=deep $(BIN)/python -m pytest -q tests
+
+# the optional comparison (Open3D ball pivoting and Poisson, CGAL advancing
+# front); Open3D's wheel needs the system library libusb-1.0
+bench-compare: $(STAMP)
+	dpkg -s libusb-1.0-0 >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq libusb-1.0-0)
+	$(BIN)/python -m pip install --quiet -e '.[test,compare]'
+	$(BIN)/python bench/run.py --data $(DATA) --out out/bench.json --compare
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

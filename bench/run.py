@@ -130,13 +130,15 @@ def bench_cgal(points: np.ndarray, repeats: int) -> list[dict]:
         advancing_front_surface_reconstruction,
     )
     from CGAL.CGAL_Kernel import Point_3
+    from CGAL.CGAL_Point_set_3 import Point_set_3
     from CGAL.CGAL_Polyhedron_3 import Polyhedron_3
 
-    pts = [Point_3(*map(float, p)) for p in points]
-
     def run():
+        ps = Point_set_3()
+        for p in points:
+            ps.insert(Point_3(float(p[0]), float(p[1]), float(p[2])))
         poly = Polyhedron_3()
-        advancing_front_surface_reconstruction(pts, poly)
+        advancing_front_surface_reconstruction(ps, poly)
         return poly
 
     try:
