@@ -1,0 +1,131 @@
+"""Scan-line sampler: on the surface, lattice spacing, coverage, determinism, errors."""
+
+import numpy as np
+import pytest
+
+cq = pytest.importorskip("cadquery")
+
+from scipy.spatial import cKDTree  # noqa: E402
+
+from samplers.scanline import SamplingError, scan  # noqa: E402
+from validators.conditions import local_delaunay  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def box():
+    return cq.Workplane().box(1, 1, 1).val()
+
+
+@pytest.fixture(scope="module")
+def cylinder():
+    return cq.Workplane().cylinder(1.0, 0.5).val()
+
+
+def test_box_samples_form_the_square_lattice(box):
+    r = scan(box, 0.05)
+    p = r.points
+    # on the surface: one coordinate is at +-0.5
+    assert np.all(np.isclose(np.abs(p), 0.5, atol=1e-12).any(axis=1))
+    d, _ = cKDTree(p).query(p, 2)
+    assert d[:, 1].min() == pytest.approx(0.05)
+    assert d[:, 1].max() == pytest.approx(0.05)
+    # 21 x 21 lattice per face, shared edges and corners once: 6*19^2 + 12*19 + 8
+    assert p.shape[0] == 6 * 19 * 19 + 12 * 19 + 8
+    ld = local_delaunay(p)
+    assert ld.max_ratio < np.sqrt(3) / 2
+    assert ld.max_degree <= 33
+
+
+def test_cylinder_samples_lie_on_it_and_cover_it(cylinder):
+    h = 0.04
+    r = scan(cylinder, h)
+    p = r.points
+    radial = np.linalg.norm(p[:, :2], axis=1)
+    on_side = np.isclose(radial, 0.5, atol=1e-9)
+    on_cap = np.isclose(np.abs(p[:, 2]), 0.5, atol=1e-12) & (radial <= 0.5 + 1e-9)
+    assert np.all(on_side | on_cap)
+    d, _ = cKDTree(p).query(p, 2)
+    assert d[:, 1].min() > 0.25 * h
+    # coverage: dense points of the true surface are within 1.5 h of a sample
+    t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    zz = np.linspace(-0.5, 0.5, 60)
+    side = np.stack(
+        [
+            0.5 * np.cos(t)[None, :].repeat(60, 0),
+            0.5 * np.sin(t)[None, :].repeat(60, 0),
+            zz[:, None].repeat(400, 1),
+        ],
+        -1,
+    ).reshape(-1, 3)
+    g = np.stack(np.meshgrid(np.linspace(-0.5, 0.5, 80), np.linspace(-0.5, 0.5, 80)), -1).reshape(
+        -1, 2
+    )
+    g = g[np.linalg.norm(g, axis=1) <= 0.5]
+    caps = np.vstack([np.c_[g, np.full(len(g), 0.5)], np.c_[g, np.full(len(g), -0.5)]])
+    dist, _ = cKDTree(p).query(np.vstack([side, caps]))
+    assert dist.max() <= 1.5 * h
+
+
+def test_features_are_sampled(box):
+    r = scan(box, 0.1)
+    corners = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
+    d, _ = cKDTree(r.points).query(corners)
+    assert d.max() < 1e-12
+    assert r.on_feature.sum() == 8 + 12 * 9
+    assert np.all(r.line_id[r.on_feature] == -1)
+    assert np.all(r.line_id[~r.on_feature] >= 0)
+
+
+def test_same_arguments_same_samples(cylinder):
+    a = scan(cylinder, 0.05, jitter=0.1, dropout=0.1, seed=3)
+    b = scan(cylinder, 0.05, jitter=0.1, dropout=0.1, seed=3)
+    c = scan(cylinder, 0.05, jitter=0.1, dropout=0.1, seed=4)
+    assert np.array_equal(a.points, b.points)
+    assert np.array_equal(a.line_id, b.line_id)
+    assert not np.array_equal(a.points, c.points)
+
+
+def test_jitter_and_dropout(box):
+    clean = scan(box, 0.1)
+    noisy = scan(box, 0.1, jitter=0.05, seed=1)
+    assert noisy.points.shape == clean.points.shape
+    assert 0 < np.abs(noisy.points - clean.points).max() < 0.05
+    fewer = scan(box, 0.1, dropout=0.5, seed=1)
+    assert 0.4 < fewer.points.shape[0] / clean.points.shape[0] < 0.6
+
+
+def test_target_points(cylinder):
+    r = scan(cylinder, target_points=3000)
+    assert 2400 < r.points.shape[0] < 3600
+
+
+def test_metadata(box):
+    r = scan(box, 0.1, ratio=1.2, seed=5)
+    m = r.meta
+    assert m["spacing"] == pytest.approx(0.1)
+    assert m["ratio"] == 1.2 and m["seed"] == 5
+    assert m["points"] == r.points.shape[0]
+    assert len(m["face_directions"]) == 6
+
+
+@pytest.mark.parametrize(
+    "kwargs, msg",
+    [
+        ({"spacing": -1.0}, "spacing must be positive, got -1.0"),
+        ({"spacing": 0.1, "ratio": 2.0}, r"ratio must be within \[0.6, 1.7\]"),
+        ({"spacing": 0.1, "jitter": -0.1}, "jitter must be a finite number >= 0"),
+        ({"spacing": 0.1, "dropout": 1.0}, r"dropout must be within \[0, 1\)"),
+        ({"spacing": 0.1, "seed": 1.5}, "seed must be an integer"),
+        ({"spacing": 0.1, "target_points": 100}, "give either spacing or target_points"),
+        ({"spacing": 0.1, "directions": [[0, 0, 0]]}, "directions must be finite, non-zero"),
+        ({"spacing": 1e-5}, "the limit is 2,000,000"),
+    ],
+)
+def test_bad_arguments(box, kwargs, msg):
+    with pytest.raises(SamplingError, match=msg):
+        scan(box, **kwargs)
+
+
+def test_not_a_shape():
+    with pytest.raises(SamplingError, match="shape must be a samplers Shape or a CadQuery shape"):
+        scan(np.zeros((3, 3)), 0.1)
