@@ -286,9 +286,9 @@ def homeomorphic(mesh, truth) -> Verdict:
             if x == y:
                 continue
             if x[0] != y[0]:
+                word = {True: "orientable", False: "non-orientable"}
                 reasons.append(
-                    f"orientability: mesh component is {'orientable' if x[0] else 'non-orientable'},"
-                    f" truth's is {'orientable' if y[0] else 'non-orientable'}"
+                    f"orientability: mesh component is {word[x[0]]}, truth's is {word[y[0]]}"
                 )
             if x[1] != y[1]:
                 reasons.append(f"Euler characteristic: mesh {x[1]}, truth {y[1]}")
