@@ -73,7 +73,7 @@ def local_delaunay(points, k: int = 12) -> LocalDelaunay:
     >>> import numpy as np
     >>> g = np.stack(np.meshgrid(np.arange(6.0), np.arange(6.0), [0.0]), -1).reshape(-1, 3)
     >>> ld = local_delaunay(g + np.random.default_rng(0).normal(0, 1e-3, g.shape))
-    >>> round(ld.worst_ratio[14], 2)  # right isosceles triangles: 1/sqrt(2)
+    >>> round(float(ld.worst_ratio[14]), 2)  # right isosceles triangles: 1/sqrt(2)
     0.71
     """
     pts = np.asarray(points, dtype=np.float64)
