@@ -1,0 +1,73 @@
+"""validators.conditions: exact answers on a flat lattice, epsilon on spheres."""
+
+import numpy as np
+import pytest
+
+pv = pytest.importorskip("pyvista")
+pytest.importorskip("potpourri3d")
+
+from validators.conditions import local_delaunay, sample_conditions  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def plane():
+    g = pv.Plane(i_size=1, j_size=1, i_resolution=200, j_resolution=200).triangulate()
+    return np.asarray(g.points, float), np.asarray(g.faces).reshape(-1, 4)[:, 1:]
+
+
+def lattice(perturb):
+    xs = np.arange(-0.45, 0.451, 0.1)
+    p = np.stack(np.meshgrid(xs, xs, [0.0]), -1).reshape(-1, 3)
+    p[:, :2] += np.random.default_rng(0).normal(0, perturb, (len(p), 2))
+    return p, len(xs)
+
+
+def grid_edges(n):
+    out = set()
+    for i in range(n):
+        for j in range(n):
+            v = i * n + j
+            if i + 1 < n:
+                out.add((v, v + n))
+            if j + 1 < n:
+                out.add((v, v + 1))
+    return out
+
+
+def test_flat_perturbed_lattice_urquhart_is_the_grid(plane):
+    p, n = lattice(0.002)
+    r = sample_conditions(p, *plane)
+    assert {tuple(e) for e in r.urquhart_edges.tolist()} == grid_edges(n)
+    assert r.epsilon < 1e-9  # flat: geodesic = Euclidean
+    assert r.max_degree <= 8
+    # right isosceles triangles, slightly perturbed: ratio near 1/sqrt(2)
+    interior = r.degree == 6
+    assert np.allclose(r.worst_ratio[interior], 1 / np.sqrt(2), atol=0.1)
+    assert r.table()[0][1] == "pass"
+
+
+def test_exact_square_lattice_ratio_is_one_over_root_two(plane):
+    p, _ = lattice(0.0)
+    ld = local_delaunay(p + np.random.default_rng(1).normal(0, 1e-6, p.shape))
+    assert ld.worst_ratio[45] == pytest.approx(1 / np.sqrt(2), abs=1e-4)
+    assert 4 <= ld.degree[45] <= 8
+
+
+def fibonacci(n):
+    i = np.arange(n) + 0.5
+    phi = np.arccos(1 - 2 * i / n)
+    th = np.pi * (1 + 5**0.5) * i
+    return np.stack([np.cos(th) * np.sin(phi), np.sin(th) * np.sin(phi), np.cos(phi)], 1)
+
+
+def test_epsilon_shrinks_as_the_sphere_sampling_gets_denser():
+    s = pv.Icosphere(radius=1, nsub=5)
+    v, f = np.asarray(s.points, float), np.asarray(s.faces).reshape(-1, 4)[:, 1:]
+    eps = [sample_conditions(fibonacci(n), v, f).epsilon for n in (60, 240, 960)]
+    assert eps[0] > eps[1] > eps[2] > 0
+
+
+def test_too_coarse_truth_is_an_error(plane):
+    p = np.array([[0, 0, 0], [1e-5, 0, 0], [0.2, 0.2, 0]], float)
+    with pytest.raises(ValueError, match="truth mesh is too coarse"):
+        sample_conditions(p, *plane)
