@@ -164,6 +164,88 @@ def _cmd_sample(args) -> int:
     return 0
 
 
+def _cmd_validate(args) -> int:
+    import numpy as np
+    from scipy.spatial import cKDTree
+
+    from validators.intersections import self_intersections
+    from validators.signature import homeomorphic, signature
+    from validators.topology import mesh_stats
+
+    from .io import read_mesh, read_points
+
+    v, f = read_mesh(args.mesh)
+    if f.shape[0] == 0:
+        raise InputError(f"{args.mesh}: has no faces; validate needs a triangle mesh")
+    sig = signature(f, v.shape[0], points=v)
+    stats = mesh_stats(f, v.shape[0])
+    crossing = self_intersections(v, f)
+    rows = [("mesh", str(args.mesh))] + _stats_rows(stats)
+    rows += [
+        ("orientable", "yes" if sig.orientable else "NO"),
+        ("genus per component", ", ".join(str(c.genus) for c in sig.components)),
+        ("non-manifold vertices", str(sig.non_manifold_vertices.shape[0])),
+        ("duplicate faces", str(sig.duplicate_faces)),
+        ("degenerate faces", str(sig.degenerate_faces)),
+        ("self-intersecting pairs", str(crossing.shape[0])),
+    ]
+    doc: dict = {"mesh": str(args.mesh), "stats": stats.as_dict()}
+    if args.points:
+        pts = read_points(args.points)
+        d, _ = cKDTree(v).query(pts)
+        missing = int((d > 1e-9 * max(1.0, float(np.abs(v).max()))).sum())
+        rows.append(("input points not vertices", str(missing)))
+        doc["points_not_vertices"] = missing
+    ok = sig.manifold and sig.orientable and crossing.shape[0] == 0 and stats.overloaded_edges == 0
+    if args.truth:
+        from validators.fidelity import hausdorff
+
+        tv, tf = read_mesh(args.truth)
+        verdict = homeomorphic(sig, signature(tf, tv.shape[0], points=tv))
+        spacing = float(np.median(cKDTree(v).query(v, 2)[0][:, 1]))
+        fid = hausdorff(v, f, tv, tf, spacing=spacing, samples=5000)
+        rows += [
+            ("truth", str(args.truth)),
+            ("homeomorphic to truth", "yes" if verdict else "NO"),
+        ]
+        rows += [("  reason", r) for r in verdict.reasons]
+        rows += [
+            ("Hausdorff / h", f"{fid.hausdorff_h:.4f}"),
+            ("mean distance / h", f"{fid.mean_h:.4f}"),
+        ]
+        ok = bool(verdict) and crossing.shape[0] == 0
+        doc["homeomorphic"] = bool(verdict)
+        doc["reasons"] = list(verdict.reasons)
+        doc["hausdorff_h"] = fid.hausdorff_h
+    print(_table(rows))
+    doc["ok"] = bool(ok)
+    if args.json:
+        from .io import write_text
+
+        write_text(args.json, json.dumps(doc, indent=2) + "\n")
+    return 0 if ok else 1
+
+
+def _cmd_conditions(args) -> int:
+    from validators.conditions import sample_conditions
+
+    from .io import read_mesh, read_points
+
+    pts = read_points(args.points)
+    tv, tf = read_mesh(args.truth)
+    if tf.shape[0] == 0:
+        raise InputError(f"{args.truth}: has no faces; the truth must be a triangle mesh")
+    try:
+        rep = sample_conditions(pts, tv, tf)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    width = max(len(r[0]) for r in rep.table())
+    print(f"{'condition':<{width}}  {'result':<12}  {'measured':<10}  worst samples")
+    for name, res, fig, worst in rep.table():
+        print(f"{name:<{width}}  {res:<12}  {fig:<10}  {worst}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="sr33", description="Reconstruct surfaces with sharp features from point samples."
@@ -193,6 +275,16 @@ def build_parser() -> argparse.ArgumentParser:
     sm.add_argument("--truth", help="also write the ground-truth mesh here")
     sm.add_argument("--meta", help="also write the metadata as JSON here")
     sm.set_defaults(func=_cmd_sample)
+    va = sub.add_parser("validate", help="topology, defects and fidelity of a mesh")
+    va.add_argument("mesh")
+    va.add_argument("--truth", help="ground-truth mesh: homeomorphism and Hausdorff distance")
+    va.add_argument("--points", help="the input samples: are they all vertices?")
+    va.add_argument("--json", help="also write the report as JSON here")
+    va.set_defaults(func=_cmd_validate)
+    co = sub.add_parser("conditions", help="measure the paper's sample conditions")
+    co.add_argument("points")
+    co.add_argument("--truth", required=True, help="ground-truth mesh, much finer than h")
+    co.set_defaults(func=_cmd_conditions)
     s = sub.add_parser("stats", help="print topology figures of a mesh")
     s.add_argument("mesh")
     s.set_defaults(func=_cmd_stats)

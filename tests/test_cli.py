@@ -234,3 +234,26 @@ def test_console_script_runs_on_a_paper_set(tmp_path):
     assert res.returncode == 0, res.stderr
     assert "overloaded edges          0" in res.stdout
     assert out.exists()
+
+
+def test_validate_exit_codes(cube_xyz, tmp_path, capsys):
+    good = tmp_path / "good.ply"
+    assert main(["reconstruct", str(cube_xyz), "-k", "12", "-o", str(good), "-q"]) == 0
+    capsys.readouterr()
+    code, out, _ = run(["validate", str(good), "--points", str(cube_xyz)], capsys)
+    assert code == 0
+    assert "self-intersecting pairs    0" in out
+    assert "input points not vertices  0" in out
+    # drop one face: no longer homeomorphic to the full cube
+    v, f = read_mesh(good)
+    holed = tmp_path / "holed.ply"
+    write_mesh(holed, v, f[1:])
+    code, out, _ = run(["validate", str(holed), "--truth", str(good)], capsys)
+    assert code == 1
+    assert "Euler characteristic: mesh 1, truth 2" in out
+    assert "boundary loops: mesh 1, truth 0" in out
+
+
+def test_validate_bad_input(tmp_path, capsys):
+    msg = error_of(["validate", str(tmp_path / "none.ply")], capsys)
+    assert msg.endswith("none.ply: no such file")
