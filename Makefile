@@ -6,7 +6,7 @@ BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed
 DATA    ?= ../shared/datasets
 
-.PHONY: install demo test bench bench-compare lint fuzz clean
+.PHONY: install demo demo-paper test bench bench-compare lint fuzz clean
 
 install: $(STAMP)
 
@@ -16,7 +16,18 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+# the main job end to end: sample a sharp CAD shape (a block with two
+# through-holes, genus 2) like a line scanner, reconstruct it, and check the
+# result against the shape's own ground truth
+DEMO_SHAPE ?= block_two_holes
+
 demo: $(STAMP)
+	mkdir -p out
+	$(BIN)/sr33 sample $(DEMO_SHAPE) -o out/demo_points.ply --truth out/demo_truth.ply --meta out/demo_meta.json
+	$(BIN)/sr33 reconstruct out/demo_points.ply -k 33 -o out/demo_mesh.ply
+	$(BIN)/sr33 validate out/demo_mesh.ply --truth out/demo_truth.ply --points out/demo_points.ply
+
+demo-paper: $(STAMP)
 	mkdir -p out
 	$(BIN)/sr33 reconstruct $(DATA)/paper/large/cube.obj -k 33 -o out/cube.ply
 
