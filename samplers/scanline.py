@@ -27,6 +27,9 @@ a CadQuery shape:
 * samples closer than ``min(1, r) · h / 2`` to an earlier one are dropped
   (corners first, then edges, then scan lines), so no two samples are
   closer than a quarter of the spacing;
+* where the rows leave a gap (planes grazing a face: the poles of a sphere),
+  extra samples are projected onto the surface until every point of it is
+  within h of a sample (their ``line_id`` is -2);
 * optional Gaussian jitter (σ·h) and dropout, both seeded.
 
 Every sample before jitter lies on the CAD surface (points are evaluated on
@@ -41,10 +44,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 EDGE_STEP = 1.0  # spacing of corner/edge samples, times h
 FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times h
+FILL_RADIUS = 1.0  # gaps wider than this (times h) get extra samples
 RATIO_RANGE = (0.6, 1.7)  # inside (1/sqrt(3), sqrt(3)) = (0.577, 1.732) with margin
 
 
@@ -62,7 +67,7 @@ class ScanSamples:
         The samples.
     line_id : (n,) int64
         Scan line of each sample; -1 for samples placed on corners and sharp
-        or boundary edges.
+        or boundary edges, -2 for samples filling a gap between rows.
     face_id : (n,) int64
         Index (in ``shape.Faces()`` order) of the CAD face the sample lies on;
         for corner and edge samples, the first adjacent face.
@@ -382,6 +387,48 @@ def _thin(points: np.ndarray, radius: float) -> np.ndarray:
     return np.array(keep, dtype=np.int64)
 
 
+def _fill_gaps(occ, faces, points: np.ndarray, h: float, size: float) -> np.ndarray:
+    """Samples added where the scan lines leave a gap wider than the spacing.
+
+    Scan planes meet a face at a grazing angle where its normal turns towards
+    the sweep direction (the poles of a sphere, a cone tip's neighbourhood),
+    and the rows there are far apart.  Dense points of a fine tessellation
+    farther than ``FILL_RADIUS · h`` from every sample are filled greedily,
+    farthest first, each projected exactly onto the CAD surface, until every
+    dense point is within that radius.
+    """
+    import cadquery as cq
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+
+    from validators.fidelity import surface_points
+
+    tv, tt = occ.tessellate(size / 500.0, 0.1)
+    if not tt:
+        return np.empty((0, 3))
+    dense = surface_points(np.array([v.toTuple() for v in tv]), np.array(tt), 20000, seed=0)
+    dist, _ = cKDTree(points).query(dense)
+    radius = FILL_RADIUS * h
+    if dist.max() <= radius:
+        return np.empty((0, 3))
+    compound = cq.Compound.makeCompound(faces)
+    dtree = cKDTree(dense)
+    added: list[np.ndarray] = []
+    for _ in range(dense.shape[0]):
+        i = int(np.argmax(dist))
+        if dist[i] <= radius:
+            break
+        ext = BRepExtrema_DistShapeShape(cq.Vertex.makeVertex(*dense[i]).wrapped, compound.wrapped)
+        q = ext.PointOnShape2(1)
+        p = np.array([q.X(), q.Y(), q.Z()])
+        added.append(p)
+        near = dtree.query_ball_point(p, dist[i] + radius)
+        if near:
+            idx = np.array(near)
+            dist[idx] = np.minimum(dist[idx], np.linalg.norm(dense[idx] - p, axis=1))
+        dist[i] = 0.0
+    return np.array(added).reshape(-1, 3)
+
+
 def _basis(d: np.ndarray) -> np.ndarray:
     return d / np.linalg.norm(d)
 
@@ -493,6 +540,12 @@ def scan(
     line_id = np.array(line_ids, dtype=np.int64)[keep]
     face_id = np.array(fids, dtype=np.int64)[keep]
     on_feature = keep < n_feature
+    fill = _fill_gaps(occ, faces, points, h, size)
+    if fill.shape[0]:
+        points = np.vstack([points, fill])
+        line_id = np.r_[line_id, np.full(fill.shape[0], -2, dtype=np.int64)]
+        face_id = np.r_[face_id, [_nearest_face(q, faces) for q in fill]].astype(np.int64)
+        on_feature = np.r_[on_feature, np.zeros(fill.shape[0], dtype=bool)]
     rng = np.random.default_rng(seed)
     if jitter > 0:
         points = points + rng.normal(size=points.shape) * (jitter * h)

@@ -1,0 +1,66 @@
+"""Every library shape, default parameters and spacing: the sampler's promises."""
+
+import numpy as np
+import pytest
+
+pytest.importorskip("cadquery")
+
+from scipy.spatial import cKDTree  # noqa: E402
+
+from samplers import shapes  # noqa: E402
+from samplers.scanline import scan  # noqa: E402
+from validators import mesh_stats  # noqa: E402
+from validators.fidelity import surface_points  # noqa: E402
+
+NAMES = shapes.shape_names()
+
+
+@pytest.fixture(scope="module")
+def sampled():
+    out = {}
+    for name in NAMES:
+        s = shapes.build(name)
+        out[name] = (s, scan(s))
+    return out
+
+
+def cad_distance(solid, points):
+    import cadquery as cq
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+
+    faces = cq.Compound.makeCompound(solid.Faces())
+    return np.array(
+        [
+            BRepExtrema_DistShapeShape(cq.Vertex.makeVertex(*p).wrapped, faces.wrapped).Value()
+            for p in points
+        ]
+    )
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_default_sampling_meets_the_sampler_contract(sampled, name):
+    s, r = sampled[name]
+    p, h = r.points, r.meta["spacing"]
+    assert 2000 <= p.shape[0] <= 20000
+    # truth: watertight (or the sheet's one boundary loop), expected Euler characteristic
+    t = mesh_stats(s.truth_triangles, s.truth_vertices.shape[0])
+    assert t.overloaded_edges == 0
+    assert t.euler == s.expected.euler
+    assert t.boundary_loops == s.expected.boundary_loops
+    # every sample on the CAD surface (a deterministic subset, exact OCC distance)
+    pick = p[np.linspace(0, p.shape[0] - 1, 60).astype(int)]
+    assert cad_distance(s.solid, pick).max() < 1e-6 * s.size
+    # coverage: every point of the truth surface within 1.5 h of a sample
+    dense = surface_points(s.truth_vertices, s.truth_triangles, 20000, seed=2)
+    assert cKDTree(p).query(dense)[0].max() <= 1.5 * h
+    # no two samples closer than h / 4
+    d, _ = cKDTree(p).query(p, 2)
+    assert d[:, 1].min() >= 0.25 * h
+
+
+@pytest.mark.parametrize("name", ["cube", "cone_tip", "L_sheet"])
+def test_same_arguments_identical_arrays(sampled, name):
+    s, r = sampled[name]
+    again = scan(shapes.build(name))
+    assert np.array_equal(r.points, again.points)
+    assert np.array_equal(r.face_id, again.face_id)
