@@ -71,3 +71,26 @@ def test_too_coarse_truth_is_an_error(plane):
     p = np.array([[0, 0, 0], [1e-5, 0, 0], [0.2, 0.2, 0]], float)
     with pytest.raises(ValueError, match="truth mesh is too coarse"):
         sample_conditions(p, *plane)
+
+
+def test_exact_square_lattice_dt_m_is_right_isosceles(plane):
+    p, n = lattice(0.0)
+    r = sample_conditions(p, *plane)
+    ratios = r.worst_ratio[np.isfinite(r.worst_ratio)]
+    assert np.allclose(ratios, 1 / np.sqrt(2), rtol=1e-6)  # truth stored as float32
+    # the 4 corners have DT_M degree 2 or 3; a full interior star has 6 (or 4..8)
+    assert r.max_degree <= 8
+    assert r.table()[1][1] == "pass"
+
+
+def test_conditions_command(plane, tmp_path, capsys):
+    from sr33.cli import main
+    from sr33.io import write_mesh, write_points
+
+    p, _ = lattice(0.002)
+    write_points(tmp_path / "p.xyz", p)
+    write_mesh(tmp_path / "t.ply", *plane)
+    assert main(["conditions", str(tmp_path / "p.xyz"), "--truth", str(tmp_path / "t.ply")]) == 0
+    out = capsys.readouterr().out
+    assert "III-i  DT_M degree <= 33" in out and "pass" in out
+    assert "II-ii  geodesic distortion epsilon" in out

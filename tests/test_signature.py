@@ -86,3 +86,16 @@ def test_degenerate_face_with_points():
 
 def test_unused_points_counted():
     assert signature(TETRA, n_points=10).unused_points == 6
+
+
+def test_shared_meshes_are_spheres():
+    from sr33.io import read_mesh
+    from tests.helpers import MESHES, need
+
+    for name in ("spot", "cheburashka"):
+        v, f = read_mesh(need(MESHES / f"{name}.obj"))
+        s = signature(f, v.shape[0], points=v)
+        assert [(c.orientable, c.euler, c.boundary_loops, c.genus) for c in s.components] == [
+            (True, 2, 0, 0)
+        ]
+        assert s.manifold and s.unused_points == 0
