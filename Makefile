@@ -37,6 +37,8 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python bench/run.py --data $(DATA) --out out/bench.json
+	$(BIN)/python bench/samplers_report.py --out out/samplers.json
+	$(BIN)/python bench/validators_bench.py
 
 fuzz: $(STAMP)
 	HYPOTHESIS_PROFILE=deep $(BIN)/python -m pytest -q tests
