@@ -38,3 +38,16 @@ def oriented_triangle_set(triangles, labels=None) -> set[tuple[int, ...]]:
         m = min(a, b, c)
         out.add((a, b, c) if a == m else (b, c, a) if b == m else (c, a, b))
     return out
+
+
+def grid_edges(nx: int, ny: int) -> set[tuple[int, int]]:
+    """Edges of an nx x ny square grid whose point ``i * ny + j`` is at (i, j)."""
+    out = set()
+    for i in range(nx):
+        for j in range(ny):
+            v = i * ny + j
+            if i + 1 < nx:
+                out.add((v, v + ny))
+            if j + 1 < ny:
+                out.add((v, v + 1))
+    return out

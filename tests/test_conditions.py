@@ -6,6 +6,7 @@ import pytest
 pv = pytest.importorskip("pyvista")
 pytest.importorskip("potpourri3d")
 
+from tests.helpers import grid_edges  # noqa: E402
 from validators.conditions import local_delaunay, sample_conditions  # noqa: E402
 
 
@@ -22,22 +23,10 @@ def lattice(perturb):
     return p, len(xs)
 
 
-def grid_edges(n):
-    out = set()
-    for i in range(n):
-        for j in range(n):
-            v = i * n + j
-            if i + 1 < n:
-                out.add((v, v + n))
-            if j + 1 < n:
-                out.add((v, v + 1))
-    return out
-
-
 def test_flat_perturbed_lattice_urquhart_is_the_grid(plane):
     p, n = lattice(0.002)
     r = sample_conditions(p, *plane)
-    assert {tuple(e) for e in r.urquhart_edges.tolist()} == grid_edges(n)
+    assert {tuple(e) for e in r.urquhart_edges.tolist()} == grid_edges(n, n)
     assert r.epsilon < 1e-9  # flat: geodesic = Euclidean
     assert r.max_degree <= 8
     # right isosceles triangles, slightly perturbed: ratio near 1/sqrt(2)

@@ -7,24 +7,13 @@ from hypothesis import strategies as st
 
 from samplers import cube_lattice, grid_lattice
 from sr33 import DEFAULT, InputError, k_neighbourhoods, localized_rng
+from tests.helpers import grid_edges
 from tests.naive import naive_localized_rng, naive_neighbourhoods
 from tests.strategies import clouds
 
 
 def as_set(edges):
     return {tuple(map(int, e)) for e in edges}
-
-
-def grid_edges(nx, ny):
-    out = set()
-    for i in range(nx):
-        for j in range(ny):
-            v = i * ny + j
-            if i + 1 < nx:
-                out.add((v, v + ny))
-            if j + 1 < ny:
-                out.add((v, v + 1))
-    return out
 
 
 @pytest.mark.parametrize("k", [4, 8, 15, 24])
