@@ -41,7 +41,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/validators_bench.py
 
 fuzz: $(STAMP)
-	HYPOTHESIS_PROFILE=deep $(BIN)/python -m pytest -q tests
+	HYPOTHESIS_PROFILE=deep FUZZ_REPORT=1 $(BIN)/python -m pytest -q -p no:cacheprovider tests/test_properties.py
 
 # the optional comparison (Open3D ball pivoting and Poisson, CGAL advancing
 # front); Open3D's wheel needs the system library libusb-1.0

@@ -16,3 +16,41 @@ settings.register_profile(
 )
 settings.register_profile("deep", max_examples=1000, deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+
+# --- `make fuzz` report: property, examples run, failures, seconds ------------
+_REPORT: dict[str, list[float]] = {}
+
+
+def pytest_runtest_logreport(report):
+    if report.when != "call" or "test_properties.py" not in report.nodeid:
+        return
+    name = report.nodeid.split("::", 1)[1]
+    row = _REPORT.setdefault(name, [0, 0.0])
+    row[0] += 0 if report.outcome == "passed" else 1
+    row[1] += report.duration
+
+
+def pytest_terminal_summary(terminalreporter):
+    if not os.environ.get("FUZZ_REPORT") or not _REPORT:
+        return
+    from tests.fuzzstats import EXAMPLES
+
+    tr = terminalreporter
+    tr.write_line("")
+    tr.write_line(f"{'property':<72}{'examples':>9}{'failed':>8}{'seconds':>9}")
+    for name, (failed, secs) in _REPORT.items():
+        base = name.split("[")[0].replace("test_", "", 1)
+        key = name.split("[")[1].rstrip("]") if "[" in name else ""
+        ex = EXAMPLES.get(
+            f"homeomorphism[{key}]"
+            if "homeomorphism" in base or "sharp" in base
+            else {
+                "theorem_1_2_rng_equals_urquhart_on_smooth_patches": "theorem_1_2",
+                "invariance_under_permutation_motion_and_scaling": "invariance",
+                "robustness_result_or_documented_error": "robustness",
+                "validator_soundness_planted_defects": "validator_soundness",
+            }.get(base, base),
+            0,
+        )
+        tr.write_line(f"{name:<72}{ex:>9}{'yes' if failed else '-':>8}{secs:>9.1f}")
