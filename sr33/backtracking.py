@@ -16,7 +16,11 @@ This module searches the same space, made tractable by four observations:
    on smooth parts, whose small isometric cycles are exactly its faces.
 2. **The rest splits into independent local problems.**  The remaining
    ("free") cycles contain an edge in three or more cycles, or fold onto a
-   neighbour (see :class:`sr33.tolerance.Tolerance`).  They are grouped into
+   neighbour (see :class:`sr33.tolerance.Tolerance`).  A free cycle whose
+   surface (its fan from the centroid) crosses another cycle's is never
+   selected with it: Triangulate needs disjoint interiors (Section 4), and
+   without this test cone tips and non-conforming scans got crossing or
+   twisted (non-orientable) patches.  They are grouped into
    components connected through shared edges.  Condition II-iii puts each
    face cycle inside one k-neighbourhood and Theorems 3 and 4 confine the
    ambiguity to neighbourhoods of sharp edges, corners and sharp points, so
@@ -191,6 +195,57 @@ def _fold_pairs(points, edges, inc_edge, inc_cycle, centroid, fold_degrees):
     if not out.shape[0]:
         return np.empty((0, 2), dtype=np.int64)
     return np.unique(np.sort(out, axis=1), axis=0)
+
+
+def _crossing_pairs(points, cs: CycleSet, centroid, free) -> np.ndarray:
+    """Pairs (free cycle, any cycle near it) whose centroid fans intersect.
+
+    Each cycle is fanned from its centroid; triangle pairs are tested exactly
+    (``validators.intersections``).  Only cycles that are free, or share a
+    vertex with a free cycle, take part, so the cost follows the ambiguity.
+    """
+    from validators.intersections import self_intersections
+
+    idx = np.flatnonzero(free)
+    if idx.shape[0] == 0:
+        return np.empty((0, 2), dtype=np.int64)
+    near = np.zeros(points.shape[0], dtype=bool)
+    for i in idx.tolist():
+        near[cs.cycle(i)] = True
+    lengths = cs.lengths
+    owner_all = np.repeat(np.arange(len(cs)), lengths)
+    touch = np.zeros(len(cs), dtype=bool)
+    touch[np.unique(owner_all[near[cs.vertices]])] = True
+    sel = np.flatnonzero(touch)
+    n = points.shape[0]
+    extra = centroid[sel]
+    slot = np.full(len(cs), -1, dtype=np.int64)
+    slot[sel] = np.arange(sel.shape[0])
+    tris, owner = [], []
+    for L in np.unique(lengths[sel]).tolist():
+        ids = sel[lengths[sel] == L]
+        ring = cs.vertices[cs.offsets[ids][:, None] + np.arange(L)]
+        if L == 3:
+            tris.append(ring)
+            owner.append(ids)
+            continue
+        centre = np.repeat(n + slot[ids], L)
+        tris.append(np.stack([centre, ring.ravel(), np.roll(ring, -1, axis=1).ravel()], axis=1))
+        owner.append(np.repeat(ids, L))
+    tri = np.concatenate(tris)
+    own = np.concatenate(owner)
+
+    def keep(i, j):
+        a, b = own[i], own[j]
+        return (a != b) & (free[a] | free[b])
+
+    hits = self_intersections(np.vstack([points, extra]), tri, keep=keep)
+    if hits.shape[0] == 0:
+        return np.empty((0, 2), dtype=np.int64)
+    a, b = own[hits[:, 0]], own[hits[:, 1]]
+    keep = (a != b) & (free[a] | free[b])
+    pairs = np.sort(np.stack([a[keep], b[keep]], axis=1), axis=1)
+    return np.unique(pairs, axis=0) if pairs.shape[0] else pairs
 
 
 def links_are_disks(n: int, vertex, prev, nxt) -> np.ndarray:
@@ -631,6 +686,11 @@ def backtracking(
     free[np.unique(prob.inc_cycle[ambiguous_edge[prob.inc_edge]])] = True
     if folds.shape[0]:
         free[folds.ravel()] = True
+    # free cycles whose surfaces cross each other (or a fixed cycle) are never
+    # selected together: Triangulate needs disjoint interiors (Section 4)
+    for a, b in _crossing_pairs(pts, cycles, centroid, free).tolist():
+        conflicts.setdefault(int(a), []).append(int(b))
+        conflicts.setdefault(int(b), []).append(int(a))
     state = np.where(free, -1, 1).astype(np.int64)
 
     # components of free cycles linked through shared edges

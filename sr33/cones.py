@@ -47,6 +47,57 @@ def _closest_on_triangle(p, a, b, c):
     return np.linalg.norm(p - (a + ab * v + ac * w))
 
 
+def ring_centres(points, faces) -> dict[int, int]:
+    """Stray samples that sit inside a face cycle ringing around them.
+
+    At a cone tip the selected face cycle can be the ring of samples around
+    the tip, leaving the tip itself unused; triangulating across the ring and
+    then coning the tip over one triangle would fold the other triangles over
+    it.  The cone of Section 5 is then the whole ring: this returns, for such
+    faces, face index -> the stray sample to fan from.  A stray qualifies
+    when, in the frame of the face's best-fit plane, its offset from the
+    centroid is less than the face's radius (farthest vertex from the
+    centroid) within the plane and less than twice that radius across it;
+    each face takes at most one stray, nearest faces first.
+
+    Returns
+    -------
+    dict of int to int
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    n = pts.shape[0]
+    if len(faces) == 0:
+        return {}
+    used = np.zeros(n, dtype=bool)
+    used[faces.vertices] = True
+    strays = np.flatnonzero(~used)
+    if strays.shape[0] == 0:
+        return {}
+    lengths = faces.lengths
+    owner = np.repeat(np.arange(len(faces)), lengths)
+    cen = np.zeros((len(faces), 3))
+    np.add.at(cen, owner, pts[faces.vertices])
+    cen /= lengths[:, None]
+    reach = np.zeros(len(faces))
+    np.maximum.at(reach, owner, np.linalg.norm(pts[faces.vertices] - cen[owner], axis=1))
+    tree = cKDTree(cen)
+    out: dict[int, int] = {}
+    for p in strays.tolist():
+        _, idx = tree.query(pts[p], min(8, len(faces)))
+        for fi in np.atleast_1d(idx).tolist():
+            if fi in out or lengths[fi] < 4:
+                continue
+            q = pts[faces.cycle(fi)] - cen[fi]
+            normal = np.linalg.svd(q, full_matrices=False)[2][-1]
+            off = pts[p] - cen[fi]
+            across = abs(float(off @ normal))
+            within = float(np.linalg.norm(off - (off @ normal) * normal))
+            if within < reach[fi] and across < 2 * reach[fi]:
+                out[int(fi)] = int(p)
+                break
+    return out
+
+
 def attach_cones(points, triangles, *, candidates: int = 16) -> tuple[np.ndarray, np.ndarray]:
     """Attach every sample no triangle uses, by a cone over its nearest triangle.
 

@@ -15,7 +15,7 @@ import numpy as np
 from ._progress import log, timed
 from ._validate import as_points, check_k, check_max_cycle_length, check_not_degenerate
 from .backtracking import backtracking
-from .cones import attach_cones
+from .cones import attach_cones, ring_centres
 from .cycles import CycleSet, trivial_isometric_cycles
 from .rng import localized_rng
 from .selfcheck import check_faces_and_triangles, strict_default
@@ -161,11 +161,12 @@ def reconstruct(
             quiet=quiet,
         )
     with timed("triangulate", timings):
-        tr = triangulate(pts, sel.faces, rtol=tolerance.rtol)
+        centres = ring_centres(pts, sel.faces)
+        tr = triangulate(pts, sel.faces, rtol=tolerance.rtol, centres=centres)
         tri = tr.triangles
     if strict_default() if strict is None else strict:
         with timed("self_checks", timings):
-            check_faces_and_triangles(sel.faces, tri, tr.face_of_triangle)
+            check_faces_and_triangles(sel.faces, tri, tr.face_of_triangle, centres)
     with timed("cones", timings):
         if tri.shape[0]:
             tri, coned = attach_cones(pts, tri)
@@ -192,7 +193,7 @@ def reconstruct(
         open_edges=open_edges,
         unresolved_samples=np.sort(relabel[sel.unresolved_samples]),
         non_disk_neighbourhoods=np.sort(relabel[sel.non_disk_neighbourhoods]),
-        coned_samples=np.sort(relabel[coned]),
+        coned_samples=np.sort(relabel[np.r_[coned, list(centres.values())].astype(np.int64)]),
         fallback_components=sel.fallback_components,
         timings=timings,
         k=k,

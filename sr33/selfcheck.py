@@ -32,10 +32,15 @@ def _uses(pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def check_faces_and_triangles(
-    faces: CycleSet, triangles: np.ndarray, face_of_triangle: np.ndarray
+    faces: CycleSet,
+    triangles: np.ndarray,
+    face_of_triangle: np.ndarray,
+    centres: dict[int, int] | None = None,
 ) -> None:
-    """Edge use <= 2 in the faces and the triangles; L - 2 triangles per face;
-    the triangles' Euler characteristic equals the faces'."""
+    """Edge use <= 2 in the faces and the triangles; L - 2 triangles per face
+    (L for a face coned from a centre sample); the triangles' Euler
+    characteristic equals the faces' (a cone adds one vertex, L edges and
+    L - 1 faces: no change)."""
     if len(faces) == 0:
         return
     pairs, _ = cycle_edges(faces.offsets, faces.vertices)
@@ -43,7 +48,10 @@ def check_faces_and_triangles(
     if fc.max() > 2:
         raise InternalError(f"backtracking invariant broken: an edge is used {fc.max()} times")
     per_face = np.bincount(face_of_triangle, minlength=len(faces))
-    if not np.array_equal(per_face, faces.lengths - 2):
+    want = faces.lengths - 2
+    for fi in centres or {}:
+        want[fi] += 2
+    if not np.array_equal(per_face, want):
         raise InternalError("triangulate: a face did not become length - 2 triangles")
     tp = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
     te, tc = _uses(tp)

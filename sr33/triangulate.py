@@ -197,7 +197,9 @@ def _triangulate_polygon(points, cyc, forbidden: set, rtol: float):
     return out
 
 
-def triangulate(points, faces: CycleSet, *, rtol: float = 1e-9) -> Triangulation:
+def triangulate(
+    points, faces: CycleSet, *, rtol: float = 1e-9, centres: dict[int, int] | None = None
+) -> Triangulation:
     """Triangulate(◇): line 4 of Algorithm 1, triangles with disjoint interiors.
 
     Parameters
@@ -208,6 +210,11 @@ def triangulate(points, faces: CycleSet, *, rtol: float = 1e-9) -> Triangulation
         Selected face cycles (:attr:`FaceSelection.faces`).
     rtol : float
         Relative tolerance for area ties (see :mod:`sr33.tolerance`).
+    centres : dict of int to int, optional
+        Face index -> a sample no face uses that lies inside that face (a
+        cone tip the face cycle rings around).  Such a face becomes the cone
+        of the paper's Section 5 from that sample: one triangle per cycle
+        edge, instead of a triangulation across the ring.
 
     Returns
     -------
@@ -234,15 +241,24 @@ def triangulate(points, faces: CycleSet, *, rtol: float = 1e-9) -> Triangulation
     lengths = oriented.lengths
     tri_parts: list[np.ndarray] = []
     own_parts: list[np.ndarray] = []
+    coned = np.zeros(len(oriented), dtype=bool)
+    for fi, apex in sorted((centres or {}).items()):
+        if not 0 <= fi < len(oriented) or not 0 <= apex < n:
+            raise InputError(f"centres maps face {fi} to sample {apex}: out of range")
+        cyc = oriented.cycle(fi)
+        fan = np.stack([np.full(cyc.shape[0], apex), cyc, np.roll(cyc, -1)], axis=1)
+        tri_parts.append(fan.astype(np.int64))
+        own_parts.append(np.full(cyc.shape[0], fi, dtype=np.int64))
+        coned[fi] = True
     # triangles stay as they are
-    t3 = np.flatnonzero(lengths == 3)
+    t3 = np.flatnonzero((lengths == 3) & ~coned)
     if t3.shape[0]:
         tri_parts.append(oriented.vertices[oriented.offsets[t3][:, None] + np.arange(3)])
         own_parts.append(t3)
     # quads, vectorized: the common case
-    q4 = np.flatnonzero(lengths == 4)
+    q4 = np.flatnonzero((lengths == 4) & ~coned)
     face_keys = np.unique(edge_keys(pairs[:, 0], pairs[:, 1], n))
-    sequential = [int(i) for i in np.flatnonzero(lengths > 4)]
+    sequential = [int(i) for i in np.flatnonzero((lengths > 4) & ~coned)]
     if q4.shape[0]:
         q = oriented.vertices[oriented.offsets[q4][:, None] + np.arange(4)]
         a, b, c, d = q.T

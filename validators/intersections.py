@@ -16,7 +16,6 @@ edge-crossing test in their common plane.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 
 def _seg_tri(p0, p1, a, b, c, eps):
@@ -36,13 +35,63 @@ def _seg_tri(p0, p1, a, b, c, eps):
     return ok & (u >= -tol) & (v >= -tol) & (u + v <= 1 + tol) & (t > tol) & (t < 1 - tol)
 
 
-def self_intersections(vertices, triangles) -> np.ndarray:
+def candidate_pairs(lo: np.ndarray, hi: np.ndarray, keep=None) -> np.ndarray:
+    """Pairs of boxes sharing a cell of a uniform grid (cell = median box size).
+
+    Every box is entered in each cell it overlaps; pairs are generated per
+    cell, filtered by ``keep`` (if given) before deduplication, and reported
+    once.  Unlike one search radius for all, a few large triangles do not
+    make every small one a candidate of every other.
+    """
+    ext = (hi - lo).max(axis=1)
+    cell = float(np.median(ext)) or float(ext.max()) or 1.0
+    origin = lo.min(axis=0)
+    c0 = np.floor((lo - origin) / cell).astype(np.int64)
+    c1 = np.floor((hi - origin) / cell).astype(np.int64)
+    span = c1 - c0 + 1
+    count = span.prod(axis=1)
+    owner = np.repeat(np.arange(lo.shape[0]), count)
+    start = np.repeat(np.cumsum(count) - count, count)
+    k = np.arange(owner.shape[0]) - start
+    sx, sy = span[owner, 0], span[owner, 1]
+    ix = c0[owner, 0] + k % sx
+    iy = c0[owner, 1] + (k // sx) % sy
+    iz = c0[owner, 2] + k // (sx * sy)
+    dims = c1.max(axis=0) + 1
+    key = (ix * dims[1] + iy) * dims[2] + iz
+    order = np.argsort(key, kind="stable")
+    key, owner = key[order], owner[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    sizes = np.diff(np.r_[starts, key.shape[0]])
+    # every element pairs with the later elements of its cell, vectorized
+    group_end = np.repeat(starts + sizes, sizes)
+    later = group_end - np.arange(key.shape[0]) - 1
+    if later.sum() == 0:
+        return np.empty((0, 2), dtype=np.int64)
+    first = np.repeat(np.arange(key.shape[0]), later)
+    offset = np.arange(first.shape[0]) - np.repeat(np.cumsum(later) - later, later)
+    a, b = owner[first], owner[first + 1 + offset]
+    ok = a != b
+    if keep is not None:
+        ok &= keep(a, b)
+    a, b = a[ok], b[ok]
+    n = lo.shape[0]
+    keys = np.sort(np.minimum(a, b) * n + np.maximum(a, b))
+    keys = keys[np.r_[True, keys[1:] != keys[:-1]]]
+    return np.stack([keys // n, keys % n], axis=1)
+
+
+def self_intersections(vertices, triangles, keep=None) -> np.ndarray:
     """Pairs (i, j), i < j, of triangles whose interiors intersect.
 
     Parameters
     ----------
     vertices : (n, 3) array_like of float
     triangles : (t, 3) array_like of int
+
+    keep : callable, optional
+        ``keep(i, j) -> bool array`` filters the candidate pairs before the
+        exact tests (callers that only care about some pairs).
 
     Returns
     -------
@@ -61,15 +110,13 @@ def self_intersections(vertices, triangles) -> np.ndarray:
     if t.shape[0] < 2:
         return np.empty((0, 2), dtype=np.int64)
     p = v[t]
-    cen = p.mean(axis=1)
-    rad = np.linalg.norm(p - cen[:, None, :], axis=2).max(axis=1)
     scale = float(np.abs(v).max()) or 1.0
     eps = 1e-14 * scale * scale
-    pairs = cKDTree(cen).query_pairs(2 * float(rad.max()), output_type="ndarray")
+    lo, hi = p.min(axis=1), p.max(axis=1)
+    pairs = candidate_pairs(lo, hi, keep)
     if pairs.shape[0] == 0:
         return np.empty((0, 2), dtype=np.int64)
     i, j = pairs[:, 0], pairs[:, 1]
-    lo, hi = p.min(axis=1), p.max(axis=1)
     box = np.all((lo[i] <= hi[j]) & (lo[j] <= hi[i]), axis=1)
     i, j = i[box], j[box]
     ti, tj = t[i], t[j]
@@ -92,9 +139,11 @@ def self_intersections(vertices, triangles) -> np.ndarray:
     two = np.flatnonzero((shared == 2) & ~hit)
     if two.shape[0]:
         a, b = ti[two], tj[two]
-        common = np.array([np.intersect1d(x, y)[:2] for x, y in zip(a, b)])
-        oa = np.array([np.setdiff1d(x, y)[0] for x, y in zip(a, b)])
-        ob = np.array([np.setdiff1d(y, x)[0] for x, y in zip(a, b)])
+        in_b = (a[:, :, None] == b[:, None, :]).any(axis=2)
+        in_a = (b[:, :, None] == a[:, None, :]).any(axis=2)
+        oa = a[~in_b]
+        ob = b[~in_a]
+        common = a[in_b].reshape(-1, 2)
         e0, e1 = v[common[:, 0]], v[common[:, 1]]
         na = np.cross(e1 - e0, v[oa] - e0)
         nb = np.cross(e1 - e0, v[ob] - e0)
