@@ -24,8 +24,9 @@ DEMO_SHAPE ?= block_two_holes
 demo: $(STAMP)
 	mkdir -p out
 	$(BIN)/sr33 sample $(DEMO_SHAPE) -o out/demo_points.ply --truth out/demo_truth.ply --meta out/demo_meta.json
-	$(BIN)/sr33 reconstruct out/demo_points.ply -k 33 -o out/demo_mesh.ply
+	$(BIN)/sr33 reconstruct out/demo_points.ply -k 33 -o out/demo_mesh.ply --save out/demo.npz
 	$(BIN)/sr33 validate out/demo_mesh.ply --truth out/demo_truth.ply --points out/demo_points.ply
+	$(BIN)/sr33 view out/demo.npz --truth out/demo_truth.ply --screenshot out/demo.png
 
 demo-paper: $(STAMP)
 	mkdir -p out

@@ -49,6 +49,10 @@ def _cmd_reconstruct(args) -> int:
         quiet=args.quiet,
     )
     write_mesh(out, r.vertices, r.triangles)
+    if args.save:
+        from .io import save_reconstruction
+
+        save_reconstruction(args.save, r)
     stats = mesh_stats(r.triangles, r.vertices.shape[0])
     rows = [("input", str(args.input)), ("k", str(r.k))]
     rows += [("duplicates merged", str(r.duplicates_merged))] if r.duplicates_merged else []
@@ -246,6 +250,87 @@ def _cmd_conditions(args) -> int:
     return 0
 
 
+def _cmd_view(args) -> int:
+    from gui._pv import has_display, pyvista
+
+    from .io import load_reconstruction, read_mesh
+
+    if not args.screenshot and not has_display():
+        raise InputError(
+            "no display to open a window on; render off-screen with "
+            "--screenshot out.png (sr33 view INPUT --screenshot out.png)"
+        )
+    pv = pyvista(off_screen=bool(args.screenshot))
+    from gui import Inspector
+
+    path = Path(args.input)
+    rec = None
+    if path.suffix.lower() == ".npz":
+        rec = load_reconstruction(path)
+        points = rec.vertices
+    else:
+        v, f = read_mesh(path)
+        points = v
+        if f.shape[0]:
+            from .reconstruct import reconstruct
+
+            rec = (
+                reconstruct(v, args.k)
+                if args.reconstruct
+                else _mesh_as_reconstruction(v, f, args.k)
+            )
+    truth = read_mesh(args.truth) if args.truth else None
+    if truth is not None and truth[1].shape[0] == 0:
+        raise InputError(f"{args.truth}: has no faces; the truth must be a triangle mesh")
+    shape = (1, 2) if args.side_by_side else (1, 1)
+    size = (1600, 800) if args.side_by_side else (1000, 800)
+    plotter = pv.Plotter(off_screen=bool(args.screenshot), shape=shape, window_size=size)
+    ins = Inspector(
+        plotter, points, k=args.k, truth=truth, reconstruction=rec, widgets=not args.screenshot
+    )
+    for layer in args.show or []:
+        ins.set_layer(layer, True)
+    for layer in args.hide or []:
+        ins.set_layer(layer, False)
+    if args.screenshot:
+        from .io import _atomic
+
+        with _atomic(args.screenshot, (".png",), "screenshot") as (tmp, _):
+            ins.screenshot(tmp)
+        print(f"screenshot written to {args.screenshot}")
+        return 0
+    plotter.show(title="sr33 inspector")
+    return 0
+
+
+def _mesh_as_reconstruction(v, f, k):
+    """A mesh file shown as it is (its own faces, no RNG or cycles)."""
+    import numpy as np
+
+    from .cycles import CycleSet
+    from .reconstruct import Reconstruction
+
+    n = v.shape[0]
+    return Reconstruction(
+        vertices=v,
+        triangles=f,
+        input_to_vertex=np.arange(n),
+        duplicates_merged=0,
+        rng_edges=np.empty((0, 2), dtype=np.int64),
+        candidate_cycles=0,
+        face_cycles=CycleSet(np.arange(0, 3 * f.shape[0] + 1, 3), f.ravel().astype(np.int64)),
+        success=True,
+        orientable=True,
+        open_edges=np.empty((0, 2), dtype=np.int64),
+        unresolved_samples=np.empty(0, dtype=np.int64),
+        non_disk_neighbourhoods=np.empty(0, dtype=np.int64),
+        coned_samples=np.empty(0, dtype=np.int64),
+        fallback_components=0,
+        timings={},
+        k=k,
+    )
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="sr33", description="Reconstruct surfaces with sharp features from point samples."
@@ -259,6 +344,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--max-cycle-length", type=int, default=8, help="longest face cycle")
     r.add_argument("--budget", type=int, default=20000, help="search budget per component")
     r.add_argument("--json", help="also write the summary as JSON here")
+    r.add_argument("--save", help="also save the whole reconstruction (.npz) for sr33 view")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     r.set_defaults(func=_cmd_reconstruct)
     sm = sub.add_parser("sample", help="scan-line samples of a sharp CAD shape")
@@ -285,6 +371,20 @@ def build_parser() -> argparse.ArgumentParser:
     co.add_argument("points")
     co.add_argument("--truth", required=True, help="ground-truth mesh, much finer than h")
     co.set_defaults(func=_cmd_conditions)
+    vw = sub.add_parser("view", help="inspect a reconstruction (PyVista window or screenshot)")
+    vw.add_argument("input", help="points (reconstructed first), a mesh, or a saved .npz")
+    vw.add_argument("--truth", help="ground-truth mesh, drawn translucent")
+    vw.add_argument("-k", type=int, default=33, help="neighbourhood size (default 33)")
+    vw.add_argument("--screenshot", help="render off-screen to this PNG and exit")
+    vw.add_argument("--side-by-side", action="store_true", help="truth in a second view")
+    vw.add_argument(
+        "--reconstruct",
+        action="store_true",
+        help="treat a mesh INPUT's vertices as samples and reconstruct them",
+    )
+    vw.add_argument("--show", action="append", help="turn a layer on (repeatable)")
+    vw.add_argument("--hide", action="append", help="turn a layer off (repeatable)")
+    vw.set_defaults(func=_cmd_view)
     s = sub.add_parser("stats", help="print topology figures of a mesh")
     s.add_argument("mesh")
     s.set_defaults(func=_cmd_stats)

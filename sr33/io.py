@@ -305,3 +305,78 @@ def _unlink(path: str) -> None:
         os.unlink(path)
     except OSError:
         pass
+
+
+def save_reconstruction(path, rec) -> Path:
+    """Write a :class:`sr33.Reconstruction` to one ``.npz`` file, atomically.
+
+    Everything round-trips: vertices, triangles, the RNG edges, the face
+    cycles, the status arrays, the timings and k (see
+    :func:`load_reconstruction`).
+    """
+    arrays = {
+        "vertices": rec.vertices,
+        "triangles": rec.triangles,
+        "input_to_vertex": rec.input_to_vertex,
+        "rng_edges": rec.rng_edges,
+        "face_offsets": rec.face_cycles.offsets,
+        "face_vertices": rec.face_cycles.vertices,
+        "open_edges": np.asarray(rec.open_edges, dtype=np.int64).reshape(-1, 2),
+        "unresolved_samples": rec.unresolved_samples,
+        "non_disk_neighbourhoods": rec.non_disk_neighbourhoods,
+        "coned_samples": rec.coned_samples,
+        "scalars": np.array(
+            [
+                rec.duplicates_merged,
+                rec.candidate_cycles,
+                int(rec.success),
+                int(rec.orientable),
+                rec.fallback_components,
+                rec.k,
+            ],
+            dtype=np.int64,
+        ),
+        "timing_names": np.array(list(rec.timings), dtype=str),
+        "timing_values": np.array(list(rec.timings.values()), dtype=np.float64),
+    }
+    with _atomic(path, (".npz",), "reconstruction") as (tmp, _):
+        with open(tmp, "wb") as fh:
+            np.savez(fh, sr33_reconstruction=np.array(1), **arrays)
+    return Path(path)
+
+
+def load_reconstruction(path):
+    """Read a reconstruction written by :func:`save_reconstruction`."""
+    from .cycles import CycleSet
+    from .reconstruct import Reconstruction
+
+    p = Path(path)
+    if not p.exists():
+        raise ReadError(f"{p}: no such file")
+    try:
+        with np.load(p, allow_pickle=False) as z:
+            if "sr33_reconstruction" not in z:
+                raise ReadError(f"{p}: not an sr33 reconstruction (.npz without its marker)")
+            s = z["scalars"]
+            return Reconstruction(
+                vertices=z["vertices"],
+                triangles=z["triangles"],
+                input_to_vertex=z["input_to_vertex"],
+                duplicates_merged=int(s[0]),
+                rng_edges=z["rng_edges"],
+                candidate_cycles=int(s[1]),
+                face_cycles=CycleSet(z["face_offsets"], z["face_vertices"]),
+                success=bool(s[2]),
+                orientable=bool(s[3]),
+                open_edges=z["open_edges"],
+                unresolved_samples=z["unresolved_samples"],
+                non_disk_neighbourhoods=z["non_disk_neighbourhoods"],
+                coned_samples=z["coned_samples"],
+                fallback_components=int(s[4]),
+                timings=dict(zip(z["timing_names"].tolist(), z["timing_values"].tolist())),
+                k=int(s[5]),
+            )
+    except InputError:
+        raise
+    except Exception as exc:
+        raise ReadError(f"{p}: unreadable reconstruction ({type(exc).__name__}: {exc})") from None

@@ -1,0 +1,127 @@
+"""The inspector, driven off-screen: layers, k slider, picking, screenshots."""
+
+import os
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pyvista")
+
+from gui._pv import pyvista  # noqa: E402
+
+pv = pyvista(off_screen=True)
+
+from gui import COLOURS, LAYERS, Inspector  # noqa: E402
+from samplers import cube_lattice  # noqa: E402
+from sr33 import Reconstruction, k_neighbourhoods, reconstruct  # noqa: E402
+from sr33.cli import main  # noqa: E402
+from sr33.io import load_reconstruction, read_points, save_reconstruction  # noqa: E402
+from tests.helpers import PAPER_SMALL, need  # noqa: E402
+
+
+def red_pixels(img):
+    r, g, b = COLOURS["open"]
+    return int(((img[..., 0] > 240) & (img[..., 1] < 20) & (img[..., 2] < 20)).sum())
+
+
+@pytest.fixture(scope="module")
+def cube():
+    pts = cube_lattice(6)
+    return pts, reconstruct(pts, 12)
+
+
+def plotter():
+    return pv.Plotter(off_screen=True, window_size=(500, 400))
+
+
+def test_every_layer_toggles_state_and_actors(cube):
+    pts, rec = cube
+    ins = Inspector(plotter(), pts, k=12, reconstruction=rec, truth=(pts, rec.triangles))
+    for name in LAYERS:
+        for on in (False, True):
+            ins.set_layer(name, on)
+            assert ins.state.layers[name] is on
+            assert all(bool(a.GetVisibility()) is on for a in ins._actors.get(name, []))
+    with pytest.raises(ValueError, match="layer must be one of"):
+        ins.set_layer("nope", True)
+
+
+def test_defect_colour_only_with_a_defect_and_the_layer_on(cube):
+    pts, rec = cube
+    broken = Reconstruction(**{**rec.__dict__, "triangles": rec.triangles[3:]})
+    hole = int(rec.triangles[0, 0])
+    p = plotter()
+    ins = Inspector(p, pts, k=12, reconstruction=broken)
+    assert ins.state.figures["open_edges"] > 0
+    ins.look_at(hole, 3.0)
+    assert red_pixels(p.screenshot(return_img=True)) > 100
+    ins.set_layer("defects", False)
+    assert red_pixels(p.screenshot(return_img=True)) == 0
+    p2 = plotter()
+    clean = Inspector(p2, pts, k=12, reconstruction=rec)
+    clean.look_at(hole, 3.0)
+    assert clean.state.figures["open_edges"] == 0
+    assert red_pixels(p2.screenshot(return_img=True)) == 0
+
+
+def test_k_slider_reruns_and_changes_the_figures():
+    pts = read_points(need(PAPER_SMALL / "cutcube.obj"))
+    p = plotter()
+    ins = Inspector(p, pts, k=16)
+    before = dict(ins.state.figures)
+    camera = list(p.camera_position)
+    # drive the slider widget itself: set its value and fire its end event
+    p.render()
+    p.iren.initialize()
+    rep = ins._slider.GetRepresentation()
+    rep.SetValue(12)
+    ins._slider.InvokeEvent("EndInteractionEvent")
+    assert ins.state.k == 12
+    assert ins.state.figures != before
+    assert ins.state.figures["open_edges"] > 0 and before["open_edges"] == 0
+    assert [tuple(x) for x in p.camera_position] == [tuple(x) for x in camera]
+
+
+def test_picking_selects_the_sample_and_shows_its_neighbourhood(cube):
+    pts, rec = cube
+    ins = Inspector(plotter(), pts, k=12, reconstruction=rec)
+    ins._on_pick(rec.vertices[37] + 1e-9)
+    assert ins.state.picked == 37
+    info = ins.pick(37)
+    assert set(info["neighbourhood"]) == set(k_neighbourhoods(rec.vertices, 12).of(37).tolist())
+    assert info["faces"] >= 3 and info["rng_degree"] >= 3
+    assert len(ins._pick_actors) >= 2
+
+
+def test_screenshot_and_side_by_side(cube, tmp_path):
+    pts, rec = cube
+    p = pv.Plotter(off_screen=True, shape=(1, 2), window_size=(800, 400))
+    ins = Inspector(p, pts, k=12, reconstruction=rec, truth=(pts, rec.triangles))
+    out = ins.screenshot(tmp_path / "x.png")
+    assert os.path.getsize(out) > 1000
+
+
+def test_reconstruction_round_trips_through_npz(cube, tmp_path):
+    _, rec = cube
+    path = save_reconstruction(tmp_path / "r.npz", rec)
+    back = load_reconstruction(path)
+    for name in ("vertices", "triangles", "rng_edges", "open_edges", "unresolved_samples"):
+        assert np.array_equal(getattr(back, name), getattr(rec, name))
+    assert back.face_cycles.as_tuples() == rec.face_cycles.as_tuples()
+    assert (back.success, back.k, back.timings) == (rec.success, rec.k, rec.timings)
+
+
+def test_view_command_writes_a_screenshot(tmp_path, capsys):
+    src = need(PAPER_SMALL / "cube.obj")
+    out = tmp_path / "v.png"
+    assert main(["view", str(src), "-k", "16", "--screenshot", str(out)]) == 0
+    assert out.stat().st_size > 1000
+    assert f"screenshot written to {out}" in capsys.readouterr().out
+
+
+def test_view_without_display_says_how(tmp_path, capsys, monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert main(["view", str(need(PAPER_SMALL / "cube.obj"))]) == 2
+    err = capsys.readouterr().err
+    assert "no display to open a window on; render off-screen with --screenshot" in err
