@@ -86,6 +86,24 @@ class Reconstruction:
     k: int = 33
 
 
+def _canonical_order(uniq, first, inverse):
+    """Order the distinct samples lexicographically by coordinates quantized to
+    1e-9 of the bounding-box diagonal (exact order breaks the remaining ties).
+
+    Exact lexicographic order is permutation invariant but not translation
+    invariant: adding 1 to coordinates that differ by less than an ulp makes
+    them equal and reorders the points.  Quantized keys are the same after a
+    translation or scaling (up to values within rounding of a bucket edge).
+    """
+    lo = uniq.min(axis=0)
+    size = float(np.linalg.norm(uniq.max(axis=0) - lo)) or 1.0
+    q = np.round((uniq - lo) / (size * 1e-9)).astype(np.int64)
+    order = np.lexsort((q[:, 2], q[:, 1], q[:, 0]))
+    back = np.empty_like(order)
+    back[order] = np.arange(order.shape[0])
+    return uniq[order], first[order], back[inverse]
+
+
 def reconstruct(
     points,
     k: int = 33,
@@ -139,12 +157,13 @@ def reconstruct(
     with timed("prepare", timings):
         uniq, first, inverse = np.unique(raw, axis=0, return_index=True, return_inverse=True)
         inverse = inverse.reshape(-1)
+        uniq, first, inverse = _canonical_order(uniq, first, inverse)
         check_not_degenerate(uniq)
         k = check_k(k, uniq.shape[0])
         dup = raw.shape[0] - uniq.shape[0]
         if dup:
             log.info("merged %d exact duplicate points", dup)
-    pts = uniq  # canonical order: lexicographic by coordinates
+    pts = uniq  # canonical order (see _canonical_order)
     with timed("localized_rng", timings):
         rng = localized_rng(pts, k, tolerance=tolerance, quiet=quiet)
     with timed("isometric_cycles", timings):

@@ -264,3 +264,13 @@ def test_validator_soundness_planted_defects(clean_mesh, kind, pick):
         bad = np.vstack([t, [m, m + 1, m + 2]])
         pairs = self_intersections(vv, bad)
         assert any(i in p for p in pairs.tolist())
+
+
+def test_regression_translation_keeps_the_canonical_order():
+    # found by the deep profile: on the cylinder, translating by (1, 0, 0)
+    # merged x coordinates closer than an ulp and reordered the samples
+    s = shapes.build("cylinder")
+    pts = scan(s).points
+    a = reconstruct(pts, 33)
+    c = reconstruct(pts + np.array([1.0, 0.0, 0.0]), 33)
+    assert triangle_set(c.triangles) == triangle_set(a.triangles)
