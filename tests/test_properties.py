@@ -274,3 +274,40 @@ def test_regression_translation_keeps_the_canonical_order():
     a = reconstruct(pts, 33)
     c = reconstruct(pts + np.array([1.0, 0.0, 0.0]), 33)
     assert triangle_set(c.triangles) == triangle_set(a.triangles)
+
+
+# Minimal failing cases the deep profile found and that are not fixed yet
+# (recorded in the closing note for planning): crossing triangles near holes
+# and cone tips, a non-manifold cone at a flatter apex, a zero-area triangle
+# at the cone tip, a hole in the conebox junction.
+OPEN_FAILURES = [
+    (
+        "block_two_holes",
+        {"length": 1.90625, "width": 1.0, "height": 0.501953125, "hole_radius": 0.25},
+        0.921875,
+        0.8515625,
+    ),
+    (
+        "box_hole",
+        {"length": 0.65625, "width": 0.65625, "height": 0.328125, "hole_radius": 0.1640625},
+        0.875,
+        0.875,
+    ),
+    ("cone", {"radius": 0.5, "height": 1.3125}, 1.0, 0.8515625),
+    ("cone", {"radius": 0.5, "height": 1.5}, 1.0, 0.8515625),
+    ("cone_tip", {"radius": 0.35, "apex_height": 1.0}, 1.125, 1.0),
+    (
+        "conebox",
+        {"length": 1.0, "width": 1.0, "height": 0.5625, "cone_radius": 0.39375, "cone_height": 0.6},
+        1.125,
+        0.8671875,
+    ),
+]
+
+
+@pytest.mark.parametrize("name, params, density, ratio", OPEN_FAILURES)
+@pytest.mark.xfail(reason="open failure found by make fuzz (see the closing note)", strict=False)
+def test_open_failures_found_by_the_deep_profile(name, params, density, ratio):
+    s = shapes.build(name, **params)
+    r = scan(s, s.default_spacing / density, ratio=ratio)
+    check_homeomorphism(s, r.points, r.meta["spacing"], reconstruct(r.points, 33))
