@@ -92,6 +92,13 @@ def _lines(points: np.ndarray, edges: np.ndarray, pv):
     return pv.PolyData(points, lines=cells)
 
 
+def _surface(points, triangles, pv):
+    """A PyVista triangle mesh."""
+    t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    faces = np.hstack([np.full((t.shape[0], 1), 3, dtype=np.int64), t]).ravel()
+    return pv.PolyData(np.asarray(points, dtype=np.float64), faces)
+
+
 def _polylines(points: np.ndarray, cycles, pv):
     cells = []
     for i in range(len(cycles)):
@@ -216,11 +223,9 @@ class Inspector:
                 "faces", _polylines(v, rec.face_cycles, pv), color=COLOURS["faces"], line_width=2
             )
         if rec.triangles.size:
-            tri = rec.triangles
-            faces = np.hstack([np.full((tri.shape[0], 1), 3, dtype=np.int64), tri]).ravel()
             self._add(
                 "surface",
-                pv.PolyData(v, faces),
+                _surface(v, rec.triangles, pv),
                 color=COLOURS["surface"],
                 show_edges=True,
                 edge_color=(150, 140, 120),
@@ -228,10 +233,9 @@ class Inspector:
             )
         if self.truth is not None:
             tv, tf = self.truth
-            faces = np.hstack([np.full((len(tf), 1), 3, dtype=np.int64), tf]).ravel()
             self._add(
                 "truth",
-                pv.PolyData(np.asarray(tv, float), faces),
+                _surface(tv, tf, pv),
                 color=COLOURS["truth"],
                 opacity=0.25,
                 pickable=False,
@@ -269,9 +273,8 @@ class Inspector:
         p.subplot(0, 1)
         if other is not None:
             tv, tf = other
-            faces = np.hstack([np.full((len(tf), 1), 3, dtype=np.int64), tf]).ravel()
             p.add_mesh(
-                pv.PolyData(np.asarray(tv, float), faces), color=COLOURS["truth"], show_edges=True
+                _surface(tv, tf, pv), color=COLOURS["truth"], show_edges=True
             )
             p.add_text("ground truth" if self.compare is None else "comparison", font_size=10)
         p.link_views()
