@@ -273,9 +273,7 @@ class Inspector:
         p.subplot(0, 1)
         if other is not None:
             tv, tf = other
-            p.add_mesh(
-                _surface(tv, tf, pv), color=COLOURS["truth"], show_edges=True
-            )
+            p.add_mesh(_surface(tv, tf, pv), color=COLOURS["truth"], show_edges=True)
             p.add_text("ground truth" if self.compare is None else "comparison", font_size=10)
         p.link_views()
         p.subplot(0, 0)
