@@ -429,10 +429,6 @@ def _fill_gaps(occ, faces, points: np.ndarray, h: float, size: float) -> np.ndar
     return np.array(added).reshape(-1, 3)
 
 
-def _basis(d: np.ndarray) -> np.ndarray:
-    return d / np.linalg.norm(d)
-
-
 def scan(
     shape,
     spacing: float | None = None,

@@ -851,7 +851,7 @@ def _truth_mesh(solid, size: float) -> tuple[np.ndarray, np.ndarray]:
 def _mesh_problem(tri: np.ndarray, expected: Topology) -> str | None:
     """Why the truth mesh does not fit ``expected``, or None."""
     e = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
-    directed, dcount = np.unique(e, axis=0, return_counts=True)
+    _, dcount = np.unique(e, axis=0, return_counts=True)
     if np.any(dcount > 1):
         return "an edge is used twice in the same direction"
     _, counts = np.unique(np.sort(e, axis=1), axis=0, return_counts=True)

@@ -551,7 +551,6 @@ def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
         for c in comp:
             state[c] = 1 if x[c] == 1 else 0
     return ok, counter[0]
-    return ok, counter[0]
 
 
 def _corner_slice(prob: _Problem, c: int) -> slice:

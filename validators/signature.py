@@ -157,8 +157,7 @@ def signature(triangles, n_points: int | None = None, points=None) -> Signature:
         cr = np.cross(p[tri[:, 1]] - p[tri[:, 0]], p[tri[:, 2]] - p[tri[:, 0]])
         degenerate |= np.linalg.norm(cr, axis=1) == 0
     st = np.sort(tri, axis=1)
-    _, first, dup_counts = np.unique(st, axis=0, return_index=True, return_counts=True)
-    duplicate = int(t - first.shape[0])
+    duplicate = int(t - np.unique(st, axis=0).shape[0])
 
     # directed edges of every triangle
     d0 = np.concatenate([tri[:, 0], tri[:, 1], tri[:, 2]])
