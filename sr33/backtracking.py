@@ -338,6 +338,7 @@ class _Problem:
         if np.any(eid < 0):
             raise InputError("cycles use a pair of points that is not an edge of the graph")
         self.cycle_edge_ids = [eid[cs.offsets[i] : cs.offsets[i + 1]] for i in range(len(cs))]
+        self.cycle_vertices = [cs.cycle(i) for i in range(len(cs))]
         self.inc_edge = eid
         self.inc_cycle = owner
         m = edges.shape[0]
@@ -388,7 +389,7 @@ def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
         cyc = prob.cycles_at_edge(e)
         cnt[e] = int(sum(1 for c in cyc if state[c] == 1))
         rem[e] = int(sum(1 for c in cyc if int(c) in comp_set))
-    verts = sorted({int(v) for c in comp for v in prob.corner_vertex[_corner_slice(prob, c)]})
+    verts = sorted({int(v) for c in comp for v in prob.cycle_vertices[c]})
     vrem = {}
     for v in verts:
         cyc, _ = prob.corners_at_vertex(v)
@@ -422,7 +423,7 @@ def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
             if val == 1:
                 cnt[e] += 1
             queue_e.append(e)
-        for v in prob.corner_vertex[_corner_slice(prob, c)]:
+        for v in prob.cycle_vertices[c]:
             v = int(v)
             vrem[v] -= 1
             queue_v.append(v)
@@ -436,7 +437,7 @@ def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
                 rem[e] += 1
                 if val == 1:
                     cnt[e] -= 1
-            for v in prob.corner_vertex[_corner_slice(prob, c)]:
+            for v in prob.cycle_vertices[c]:
                 vrem[int(v)] += 1
             x[c] = -1
 
@@ -553,13 +554,6 @@ def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
     return ok, counter[0]
 
 
-def _corner_slice(prob: _Problem, c: int) -> slice:
-    ids = prob.cycle_edge_ids[c]
-    # corners of cycle c are contiguous, same span as its cycle edges
-    start = prob._offsets[c]
-    return slice(start, start + ids.shape[0])
-
-
 def _greedy(prob: _Problem, comp, state, rank, conflicts):
     """Fallback: add cycles in rank order while edge use <= 2 and links stay disks."""
     comp = sorted(comp, key=lambda c: rank[c])
@@ -578,7 +572,7 @@ def _greedy(prob: _Problem, comp, state, rank, conflicts):
             continue
         state[c] = 1
         ok = True
-        for v in prob.corner_vertex[_corner_slice(prob, c)]:
+        for v in prob.cycle_vertices[c]:
             cyc, corner = prob.corners_at_vertex(int(v))
             pairs = [
                 (int(prob.corner_prev[k]), int(prob.corner_next[k]))
@@ -670,7 +664,6 @@ def backtracking(
             notes=("no candidate cycles",),
         )
     prob = _Problem(cycles, e, n)
-    prob._offsets = cycles.offsets
     centroid, flat = _cycle_geometry(pts, cycles)
     spread = np.linalg.norm(centroid - pts.mean(axis=0), axis=1)
     rank = _rank(cycles, _cycle_area(pts, cycles, centroid), flat, spread)
