@@ -47,14 +47,28 @@ class Triangulation:
     orientable: bool
 
 
+def _reversed(cs: CycleSet, mask: np.ndarray) -> CycleSet:
+    """The cycles with those in ``mask`` reversed (first vertex kept)."""
+    lengths = cs.lengths
+    owner = np.repeat(np.arange(len(cs)), lengths)
+    pos = np.arange(cs.vertices.shape[0])
+    j = pos - cs.offsets[owner]
+    src = np.where(mask[owner] & (j > 0), cs.offsets[owner] + lengths[owner] - j, pos)
+    return CycleSet(offsets=cs.offsets, vertices=cs.vertices[src])
+
+
 def orient_cycles(points: np.ndarray, faces: CycleSet) -> tuple[CycleSet, bool]:
     """Reverse cycles so that neighbours traverse shared edges oppositely.
 
-    Breadth-first over the face adjacency (faces sharing an edge used by
-    exactly two faces), from the canonically smallest face of each component;
-    closed components are then flipped to enclose positive volume.
-    Returns the oriented cycles and whether every component was orientable.
+    Faces sharing an edge used by exactly two faces are linked; on each
+    component the faces are oriented like its canonically smallest face,
+    read off the orientation double cover
+    (:func:`validators.signature.orientation_double_cover`); closed
+    components are then flipped to enclose positive volume.  Returns the
+    oriented cycles and whether every component was orientable.
     """
+    from validators.signature import orientation_double_cover
+
     n = points.shape[0]
     nf = len(faces)
     if nf == 0:
@@ -66,41 +80,23 @@ def orient_cycles(points: np.ndarray, faces: CycleSet) -> tuple[CycleSet, bool]:
     ks = keys[order]
     same = np.flatnonzero(ks[1:] == ks[:-1])
     # only edges shared by exactly two faces link faces
-    cnt_u, inv, cnt = np.unique(ks, return_inverse=True, return_counts=True)
+    _, inv, cnt = np.unique(ks, return_inverse=True, return_counts=True)
     two = cnt[inv[same]] == 2
     a = order[same[two]]
     b = order[same[two] + 1]
     fa, fb = owner[a], owner[b]
-    # same direction on the shared edge -> the faces need opposite flips
-    need_flip = forward[a] == forward[b]
+    coherent = forward[a] != forward[b]
     g = sparse.csr_matrix(
         (np.ones(fa.shape[0] * 2, dtype=np.int8), (np.r_[fa, fb], np.r_[fb, fa])), shape=(nf, nf)
     )
     ncomp, labels = csgraph.connected_components(g, directed=False)
-    flip = np.zeros(nf, dtype=np.int8)
-    known = np.zeros(nf, dtype=bool)
-    rel = {}
-    for i, j, f in zip(fa.tolist(), fb.tolist(), need_flip.tolist()):
-        rel[(i, j)] = f
-        rel[(j, i)] = f
-    for comp in range(ncomp):
-        root = int(np.flatnonzero(labels == comp)[0])
-        bfs, pred = csgraph.breadth_first_order(g, root, directed=False)
-        known[root] = True
-        for v in bfs[1:]:
-            p = pred[v]
-            flip[v] = flip[p] ^ rel[(int(p), int(v))]
-            known[v] = True
-    orientable = bool(np.all(flip[fa] ^ flip[fb] == need_flip))
-    # flip closed components to positive volume
-    verts = faces.vertices.copy()
-    lengths = faces.lengths
-    out_parts = []
-    for i in range(nf):
-        c = verts[faces.offsets[i] : faces.offsets[i + 1]]
-        out_parts.append(c if not flip[i] else np.r_[c[0], c[:0:-1]])
-    oriented = CycleSet(offsets=faces.offsets.copy(), vertices=np.concatenate(out_parts))
+    dlab = orientation_double_cover(nf, fa, fb, coherent)
+    orientable = bool(np.all(dlab[:nf] != dlab[nf:]))
+    _, root = np.unique(labels, return_index=True)  # smallest face of each component
+    flip = dlab[:nf] != dlab[root[labels]]
+    oriented = _reversed(faces, flip)
     # signed volume per component, from a fan triangulation of each cycle
+    lengths = faces.lengths
     p0 = points[oriented.vertices[oriented.offsets[:-1]]]
     vol = np.zeros(nf)
     for L in np.unique(lengths):
@@ -113,11 +109,7 @@ def orient_cycles(points: np.ndarray, faces: CycleSet) -> tuple[CycleSet, bool]:
     comp_vol = np.bincount(labels, weights=vol, minlength=ncomp)
     neg = comp_vol[labels] < 0
     if neg.any():
-        parts = []
-        for i in range(nf):
-            c = oriented.cycle(i)
-            parts.append(np.r_[c[0], c[:0:-1]] if neg[i] else c)
-        oriented = CycleSet(offsets=oriented.offsets, vertices=np.concatenate(parts))
+        oriented = _reversed(oriented, neg)
     return oriented, orientable
 
 

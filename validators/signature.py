@@ -101,6 +101,26 @@ class Signature:
         return sum(c.euler for c in self.components)
 
 
+def orientation_double_cover(n: int, fa, fb, coherent) -> np.ndarray:
+    """Component labels of the orientation double cover of ``n`` faces.
+
+    Face f has nodes f ("as stored") and f + n ("flipped").  Faces ``fa[i]``
+    and ``fb[i]`` share a manifold edge; when they traverse it coherently the
+    cover joins (fa, fb) and (fa + n, fb + n), otherwise (fa, fb + n) and
+    (fa + n, fb).  A face is on a non-orientable component exactly when its
+    two nodes share a label; on an orientable one, faces whose "as stored"
+    node shares the label of a reference face's need no flip relative to it.
+    """
+    fa, fb = np.asarray(fa, dtype=np.int64), np.asarray(fb, dtype=np.int64)
+    coherent = np.asarray(coherent, dtype=bool)
+    rows = np.concatenate([fa, fa + n])
+    cols = np.concatenate([np.where(coherent, fb, fb + n), np.where(coherent, fb + n, fb)])
+    dc = sparse.csr_matrix(
+        (np.ones(rows.shape[0], dtype=np.int8), (rows, cols)), shape=(2 * n, 2 * n)
+    )
+    return csgraph.connected_components(dc, directed=False)[1]
+
+
 def _fans(tri: np.ndarray, n: int) -> np.ndarray:
     """Number of fans (edge-connected triangle groups) around every vertex."""
     t = tri.shape[0]
@@ -181,14 +201,7 @@ def signature(triangles, n_points: int | None = None, points=None) -> Signature:
     )
     gf = (vert_adj @ vert_adj.T).tocsr()
     ncomp, comp = csgraph.connected_components(gf, directed=False)
-    # orientation double cover
-    nodes = 2 * t
-    rows = np.concatenate([np.where(coherent, fa, fa), np.where(coherent, fa + t, fa + t)])
-    cols = np.concatenate([np.where(coherent, fb, fb + t), np.where(coherent, fb + t, fb)])
-    dc = sparse.csr_matrix(
-        (np.ones(rows.shape[0], dtype=np.int8), (rows, cols)), shape=(nodes, nodes)
-    )
-    _, dlab = csgraph.connected_components(dc, directed=False)
+    dlab = orientation_double_cover(t, fa, fb, coherent)
     twisted = dlab[:t] == dlab[t:]
     comp_orientable = np.ones(ncomp, dtype=bool)
     comp_orientable[comp[twisted]] = False
