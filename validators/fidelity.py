@@ -76,16 +76,11 @@ def surface_points(vertices, triangles, count: int, seed: int = 0) -> np.ndarray
 
 def distance_to_surface(points, vertices, triangles) -> np.ndarray:
     """Exact unsigned distance of each point to the triangle surface."""
-    import vtk
+    import pyvista as pv
 
-    surf = _polydata(vertices, triangles)
-    f = vtk.vtkImplicitPolyDataDistance()
-    f.SetInput(surf)
-    pts = np.asarray(points, dtype=np.float64)
-    out = np.empty(pts.shape[0])
-    for i, q in enumerate(pts):
-        out[i] = abs(f.EvaluateFunction(q))
-    return out
+    cloud = pv.PolyData(np.asarray(points, dtype=np.float64).reshape(-1, 3))
+    dist = cloud.compute_implicit_distance(_polydata(vertices, triangles))["implicit_distance"]
+    return np.abs(np.asarray(dist, dtype=np.float64))
 
 
 def hausdorff(
