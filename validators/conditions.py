@@ -154,14 +154,8 @@ class ConditionReport:
     smooth: np.ndarray
     truth_genus: tuple[int, ...] = ()
 
-    @property
-    def max_degree(self) -> int:
-        return int(self.degree.max()) if self.degree.size else 0
-
-    @property
-    def max_ratio(self) -> float:
-        w = self.worst_ratio[np.isfinite(self.worst_ratio)]
-        return float(w.max()) if w.size else float("nan")
+    max_degree = LocalDelaunay.max_degree
+    max_ratio = LocalDelaunay.max_ratio
 
     def worst(self, count: int = 10) -> dict[str, list[int]]:
         """Indices of the worst samples per condition (for reports and the GUI)."""
