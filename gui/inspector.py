@@ -162,7 +162,8 @@ class Inspector:
             self._build_right()
         if widgets:
             self._add_widgets()
-        self.plotter.subplot(0, 0) if self._side_by_side else None
+        if self._side_by_side:
+            self.plotter.subplot(0, 0)
         self.plotter.reset_camera()
 
     # ------------------------------------------------------------------ layers
