@@ -56,9 +56,23 @@ def test_epsilon_shrinks_as_the_sphere_sampling_gets_denser():
     assert eps[0] > eps[1] > eps[2] > 0
 
 
-def test_too_coarse_truth_is_an_error(plane):
+def test_a_coarse_truth_is_refined_and_gives_the_same_answer(plane):
+    # the unit square as two triangles: refined and the samples inserted, the
+    # figures equal those on the 200 x 200 plane
+    v = np.array([[-0.5, -0.5, 0], [0.5, -0.5, 0], [0.5, 0.5, 0], [-0.5, 0.5, 0]], float)
+    f = np.array([[0, 1, 2], [0, 2, 3]])
+    p, n = lattice(0.002)
+    coarse = sample_conditions(p, v, f)
+    fine = sample_conditions(p, *plane)
+    assert {tuple(e) for e in coarse.urquhart_edges.tolist()} == grid_edges(n, n)
+    # near-cocircular quads may take the other diagonal (labels are mesh-Dijkstra)
+    np.testing.assert_allclose(coarse.worst_ratio, fine.worst_ratio, atol=0.05)
+    assert coarse.table()[1][1] == fine.table()[1][1] == "pass"
+
+
+def test_unreachable_resolution_is_an_error(plane):
     p = np.array([[0, 0, 0], [1e-5, 0, 0], [0.2, 0.2, 0]], float)
-    with pytest.raises(ValueError, match="truth mesh is too coarse"):
+    with pytest.raises(ValueError, match="refining the truth mesh to edges of 2e-06 needs more"):
         sample_conditions(p, *plane)
 
 

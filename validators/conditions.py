@@ -192,7 +192,43 @@ class ConditionReport:
         ]
 
 
-def sample_conditions(points, truth_vertices, truth_triangles, *, sharp_degrees: float = 30.0):
+def _geodesic_lengths(pts, edges, tv, tf, vertex_of) -> np.ndarray:
+    """Geodesic length on the truth mesh of each sample pair in ``edges``.
+
+    A pair whose chord lies on the surface (both samples on one flat face, or
+    on one ruling) has the chord as its geodesic: nothing on the surface is
+    shorter.  The others are traced by potpourri3d's edge-flip solver between
+    the truth vertices that are the samples.
+    """
+    import potpourri3d as pp3d
+
+    from .fidelity import distance_to_surface
+
+    a, b = pts[edges[:, 0]], pts[edges[:, 1]]
+    chord = np.linalg.norm(a - b, axis=1)
+    s = np.array([0.2, 0.4, 0.6, 0.8])
+    probe = (a[:, None] * (1 - s)[None, :, None] + b[:, None] * s[None, :, None]).reshape(-1, 3)
+    off = distance_to_surface(probe, tv, tf).reshape(-1, s.size).max(axis=1)
+    length = chord.copy()
+    curved = np.flatnonzero(off > 1e-9 * np.maximum(chord, 1e-300) + 1e-12)
+    if curved.size:
+        solver = pp3d.EdgeFlipGeodesicSolver(tv, tf)
+        for i in curved.tolist():
+            path = solver.find_geodesic_path(
+                int(vertex_of[edges[i, 0]]), int(vertex_of[edges[i, 1]])
+            )
+            length[i] = max(float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum()), chord[i])
+    return length
+
+
+def sample_conditions(
+    points,
+    truth_vertices,
+    truth_triangles,
+    *,
+    sharp_degrees: float = 30.0,
+    resolution: float | None = None,
+):
     """Measure Conditions II-ii, III-i and III-ii with geodesics on the truth.
 
     DT_M is the dual of the geodesic Voronoi diagram of the samples on the
@@ -200,9 +236,11 @@ def sample_conditions(points, truth_vertices, truth_triangles, *, sharp_degrees:
     by multi-source Dijkstra over the mesh edges (scipy.sparse.csgraph), a
     truth edge between two labels gives a DT_M edge and a truth triangle with
     three labels a DT_M triangle.  Geodesic lengths of DT_M edges are exact
-    mesh geodesics (potpourri3d's edge-flip solver) between the truth
-    vertices nearest to the samples, so the truth mesh must be much finer
-    than the sampling (its vertices are the resolution of the answer).
+    mesh geodesics (potpourri3d's edge-flip solver) between the samples.
+    Before that the truth is refined (:func:`validators.refine.refine_to_edge_length`)
+    until no edge is longer than ``resolution``, and every sample is made a
+    vertex of it (:func:`validators.refine.insert_points`), so that neither
+    a coarse CAD tessellation nor snapping distorts the lengths.
 
     Parameters
     ----------
@@ -211,28 +249,31 @@ def sample_conditions(points, truth_vertices, truth_triangles, *, sharp_degrees:
     truth_vertices, truth_triangles : the ground-truth mesh
     sharp_degrees : float
         Dihedral angle above which a truth edge counts as sharp.
+    resolution : float, optional
+        Longest truth edge after refinement; default a fifth of the samples'
+        median nearest-neighbour distance.
 
     Returns
     -------
     ConditionReport
     """
-    import potpourri3d as pp3d
     from scipy import sparse
     from scipy.sparse import csgraph
 
     from .fidelity import sharp_edges
+    from .refine import insert_points, refine_to_edge_length
     from .signature import signature
 
     pts = np.asarray(points, dtype=np.float64)
-    tv = np.asarray(truth_vertices, dtype=np.float64)
-    tf = np.asarray(truth_triangles, dtype=np.int64)
     n = pts.shape[0]
-    _, snap = cKDTree(tv).query(pts)
-    if np.unique(snap).shape[0] != n:
-        raise ValueError(
-            "truth mesh is too coarse: two samples share a nearest truth vertex; "
-            "refine the truth mesh well below the sample spacing"
-        )
+    if resolution is None:
+        nn, _ = cKDTree(pts).query(pts, 2)
+        resolution = float(np.median(nn[:, 1])) / 5.0
+    ov = np.asarray(truth_vertices, dtype=np.float64)
+    of = np.asarray(truth_triangles, dtype=np.int64)
+    genus = tuple(c.genus for c in signature(of, ov.shape[0]).components)
+    tv, tf = refine_to_edge_length(ov, of, resolution)
+    tv, tf, snap = insert_points(tv, tf, pts)
     e = np.concatenate([tf[:, [0, 1]], tf[:, [1, 2]], tf[:, [2, 0]]])
     e = np.unique(np.sort(e, axis=1), axis=0)
     w = np.linalg.norm(tv[e[:, 0]] - tv[e[:, 1]], axis=1)
@@ -249,11 +290,7 @@ def sample_conditions(points, truth_vertices, truth_triangles, *, sharp_degrees:
     lt = label_of_vertex[tf]
     three = (lt[:, 0] != lt[:, 1]) & (lt[:, 1] != lt[:, 2]) & (lt[:, 0] != lt[:, 2])
     dt_tri = np.unique(np.sort(lt[three], axis=1), axis=0)
-    solver = pp3d.EdgeFlipGeodesicSolver(tv, tf)
-    length = np.empty(dt_edges.shape[0])
-    for i, (a, b) in enumerate(dt_edges.tolist()):
-        path = solver.find_geodesic_path(int(snap[a]), int(snap[b]))
-        length[i] = float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+    length = _geodesic_lengths(pts, dt_edges, tv, tf, snap)
     key = dt_edges[:, 0] * n + dt_edges[:, 1]
     order = np.argsort(key)
 
@@ -279,14 +316,17 @@ def sample_conditions(points, truth_vertices, truth_triangles, *, sharp_degrees:
     keep[longest] = False
     degree = np.bincount(dt_edges.ravel(), minlength=n)
     # smooth samples: far from the truth's sharp edges
-    se = sharp_edges(tv, tf, sharp_degrees)
+    se = sharp_edges(ov, of, sharp_degrees)
     smooth = np.ones(n, dtype=bool)
     if se.shape[0]:
-        s = np.linspace(0, 1, 9)
-        feat = (
-            tv[se[:, 0]][:, None] * (1 - s)[None, :, None]
-            + tv[se[:, 1]][:, None] * s[None, :, None]
-        ).reshape(-1, 3)
+        # points along the sharp edges, no farther apart than the resolution
+        a, b = ov[se[:, 0]], ov[se[:, 1]]
+        steps = np.ceil(np.linalg.norm(b - a, axis=1) / resolution).astype(np.int64) + 1
+        edge = np.repeat(np.arange(se.shape[0]), steps)
+        frac = (np.arange(edge.size) - np.repeat(np.cumsum(steps) - steps, steps)) / np.repeat(
+            steps - 1, steps
+        )
+        feat = a[edge] * (1 - frac)[:, None] + b[edge] * frac[:, None]
         reach = np.zeros(n)
         np.maximum.at(reach, dt_edges[:, 0], length)
         np.maximum.at(reach, dt_edges[:, 1], length)
@@ -305,5 +345,5 @@ def sample_conditions(points, truth_vertices, truth_triangles, *, sharp_degrees:
         worst_ratio=worst,
         epsilon=max(eps, 0.0) if np.isfinite(eps) else eps,
         smooth=smooth,
-        truth_genus=tuple(c.genus for c in signature(tf, tv.shape[0]).components),
+        truth_genus=genus,
     )

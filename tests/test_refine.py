@@ -1,0 +1,71 @@
+"""validators.refine: conforming refinement and exact insertion of samples."""
+
+import numpy as np
+import pytest
+
+from validators import mesh_stats
+from validators.refine import insert_points, refine_to_edge_length
+from validators.topology import edge_uses
+
+
+def octahedron():
+    v = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], float)
+    f = np.array(
+        [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]]
+    )
+    return v, f
+
+
+def area(v, f):
+    return 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+
+
+def edge_lengths(v, f):
+    return np.linalg.norm(v[f] - v[np.roll(f, 1, axis=1)], axis=2)
+
+
+@pytest.mark.parametrize("bound", [0.9, 0.3, 0.05])
+def test_refinement_bounds_edges_and_keeps_surface_and_topology(bound):
+    v, f = octahedron()
+    rv, rf = refine_to_edge_length(v, f, bound)
+    assert edge_lengths(rv, rf).max() <= bound
+    assert area(rv, rf).sum() == pytest.approx(area(v, f).sum(), rel=1e-12)
+    s = mesh_stats(rf, rv.shape[0])
+    assert (s.open_edges, s.overloaded_edges, s.euler, s.components) == (0, 0, 2, 1)
+    # orientation kept: every edge used once in each direction
+    assert edge_uses(rf)[1].max() == 2
+    d = np.concatenate([rf[:, [0, 1]], rf[:, [1, 2]], rf[:, [2, 0]]])
+    assert np.unique(d, axis=0).shape[0] == d.shape[0]
+    # no sliver: smallest angle bounded (longest-edge bisection)
+    a = rv[rf]
+    for i in range(3):
+        u, w = a[:, (i + 1) % 3] - a[:, i], a[:, (i + 2) % 3] - a[:, i]
+        cos = (u * w).sum(1) / np.linalg.norm(u, axis=1) / np.linalg.norm(w, axis=1)
+        assert np.degrees(np.arccos(np.clip(cos, -1, 1))).min() > 10
+
+
+def test_insertion_makes_each_sample_a_vertex():
+    v, f = octahedron()
+    rv, rf = refine_to_edge_length(v, f, 0.1)
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=(40, 3))
+    x /= np.abs(x).sum(axis=1, keepdims=True)  # on the octahedron (|x|+|y|+|z| = 1)
+    on_edge = np.array([[0.31, 0.69, 0.0], [0.0, -0.23, 0.77]])  # on two of its edges
+    corner = np.array([[0.0, 0.0, 1.0]])
+    pts = np.vstack([x, on_edge, corner])
+    nv, nf, idx = insert_points(rv, rf, pts)
+    np.testing.assert_array_equal(nv[idx], pts)
+    assert np.unique(idx).shape[0] == pts.shape[0]
+    assert area(nv, nf).sum() == pytest.approx(area(v, f).sum(), rel=1e-9)
+    assert area(nv, nf).min() > 0
+    s = mesh_stats(nf, nv.shape[0])
+    assert (s.open_edges, s.overloaded_edges, s.euler) == (0, 0, 2)
+    # the corner sample is the octahedron's own vertex, the edge samples split edges
+    assert idx[-1] == 4
+    assert nv.shape[0] == rv.shape[0] + pts.shape[0] - 1
+
+
+def test_two_samples_on_one_vertex_is_an_error():
+    v, f = octahedron()
+    with pytest.raises(ValueError, match="two samples fall on one of its vertices"):
+        insert_points(v, f, [[0.0, 0.0, 1.0], [0.0, 1e-9, 1.0 - 1e-9]])
