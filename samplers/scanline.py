@@ -440,6 +440,7 @@ def scan(
     dropout: float = 0.0,
     seed: int = 0,
     sharp_degrees: float = 20.0,
+    repair: bool = True,
 ) -> ScanSamples:
     """Sample a CAD shape along scan lines (Condition III, Figure 1 of the paper).
 
@@ -465,6 +466,9 @@ def scan(
     sharp_degrees : float
         Edges whose faces' normals differ by more than this are sampled
         explicitly (as are boundary edges and corners).
+    repair : bool
+        Repair the boundary layers where rows meet circular edges
+        (:mod:`samplers.layers`), so that Condition III-ii holds there too.
 
     Returns
     -------
@@ -542,6 +546,19 @@ def scan(
         line_id = np.r_[line_id, np.full(fill.shape[0], -2, dtype=np.int64)]
         face_id = np.r_[face_id, [_nearest_face(q, faces) for q in fill]].astype(np.int64)
         on_feature = np.r_[on_feature, np.zeros(fill.shape[0], dtype=bool)]
+    reports: list[dict] = []
+    if repair:
+        from .layers import Samples, lattice_cylinder_faces, repair_planar_faces
+
+        bag = Samples(points, line_id, face_id, on_feature)
+        reports = repair_planar_faces(occ, bag, h, size)
+        reports += lattice_cylinder_faces(occ, bag, h, size)
+        points, line_id, face_id, on_feature = (
+            bag.points,
+            bag.line_id,
+            bag.face_id,
+            bag.on_feature,
+        )
     rng = np.random.default_rng(seed)
     if jitter > 0:
         points = points + rng.normal(size=points.shape) * (jitter * h)
@@ -567,6 +584,7 @@ def scan(
         "seed": int(seed),
         "sharp_degrees": float(sharp_degrees),
         "points": int(points.shape[0]),
+        "repairs": reports,
         "feature_points": int(on_feature.sum()),
         "lines": int(line),
         "area": area,

@@ -36,7 +36,7 @@ def _unique_edges(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([lo[first], hi[first]], axis=1), inverse.reshape(-1, 3)
 
 
-def refine_to_edge_length(vertices, triangles, max_edge: float, *, max_triangles: int = 6_000_000):
+def refine_to_edge_length(vertices, triangles, max_edge: float, *, max_triangles: int = 12_000_000):
     """Split triangles until no edge is longer than ``max_edge``.
 
     Parameters

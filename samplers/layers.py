@@ -1,0 +1,350 @@
+"""Boundary layers of the scan lattice where it meets a curved edge.
+
+Straight scan rows end on a circle (a hole, a disk's rim, the cut of a
+spherical scoop) at arbitrary places, and the cells there break Condition
+III-ii.  This module repairs those layers face by face, in coordinates in
+which the face is flat and distances are the surface's own:
+
+* a **planar** face in plane coordinates (the two global axes other than
+  the normal's when the plane is axis-aligned, so that parallel faces of a
+  prism get the same answer and a hole's two rims line up);
+* a full **cylinder** unrolled to ``(R * angle, axial)``, periodic in the
+  angle, after its rims have moved with the planar faces they bound.
+
+Samples on a sharp circular edge slide along it, samples near it move
+freely, corners, straight-edge samples and the rest of the lattice stay
+(:func:`samplers.repair.repair`).  CadQuery and OCP are imported when the
+functions run.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .repair import repair
+
+LAYER = 2.5  # samples within this many h of a circular edge may move
+RASTER = 8  # inside tests on a grid of h / RASTER
+
+
+@dataclass
+class Samples:
+    """The sample arrays of :func:`samplers.scanline.scan`, edited in place by the repairs."""
+
+    points: np.ndarray
+    line_id: np.ndarray
+    face_id: np.ndarray
+    on_feature: np.ndarray
+
+    def replace(self, drop: np.ndarray, points, line_id, face_id, on_feature) -> None:
+        keep = np.ones(self.points.shape[0], dtype=bool)
+        keep[drop] = False
+        self.points = np.vstack([self.points[keep], points])
+        self.line_id = np.r_[self.line_id[keep], line_id].astype(np.int64)
+        self.face_id = np.r_[self.face_id[keep], face_id].astype(np.int64)
+        self.on_feature = np.r_[self.on_feature[keep], on_feature].astype(bool)
+
+
+class _Raster:
+    """Inside test of a 2-D domain given by its boundary segments (even-odd rule)."""
+
+    def __init__(self, segments: np.ndarray, cell: float):
+        lo = segments.reshape(-1, 2).min(axis=0) - 2 * cell
+        hi = segments.reshape(-1, 2).max(axis=0) + 2 * cell
+        self.lo, self.cell = lo, cell
+        nx, ny = (np.ceil((hi - lo) / cell).astype(int) + 1).tolist()
+        ys = lo[1] + (np.arange(ny) + 0.5) * cell
+        xs = lo[0] + (np.arange(nx) + 0.5) * cell
+        a, b = segments[:, 0], segments[:, 1]
+        y0, y1 = a[:, 1], b[:, 1]
+        grid = np.zeros((ny, nx), dtype=bool)
+        for j, y in enumerate(ys):
+            cross = (y0 <= y) != (y1 <= y)
+            if not cross.any():
+                continue
+            t = (y - y0[cross]) / (y1[cross] - y0[cross])
+            x = np.sort(a[cross, 0] + t * (b[cross, 0] - a[cross, 0]))
+            count = np.searchsorted(x, xs)
+            grid[j] = count % 2 == 1
+        self.grid = grid
+
+    def __call__(self, pts: np.ndarray) -> np.ndarray:
+        ij = np.floor((pts - self.lo) / self.cell).astype(np.int64)
+        ny, nx = self.grid.shape
+        ok = (ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny)
+        out = np.zeros(pts.shape[0], dtype=bool)
+        out[ok] = self.grid[ij[ok, 1], ij[ok, 0]]
+        return out
+
+
+def _boundary_segments(face, to2d, tol: float) -> np.ndarray:
+    """Boundary edges of the face's own fine tessellation, in 2-D, as (s, 2, 2)."""
+    verts, tris = face.tessellate(tol, 0.05)
+    v = np.array([q.toTuple() for q in verts])
+    t = np.array(tris, dtype=np.int64).reshape(-1, 3)
+    e = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    uniq, counts = np.unique(e, axis=0, return_counts=True)
+    free = uniq[counts == 1]
+    return to2d(v)[free]
+
+
+@dataclass(frozen=True)
+class _Arc:
+    centre: np.ndarray  # 2-D
+    radius: float
+    start: float  # angle range (radians) of the arc, None-like (0, 2 pi) when closed
+    span: float
+    closed: bool
+
+    def distance(self, p: np.ndarray) -> np.ndarray:
+        return np.abs(np.linalg.norm(p - self.centre, axis=1) - self.radius)
+
+    def project(self, p: np.ndarray, margin: float) -> np.ndarray:
+        d = p - self.centre
+        ang = np.arctan2(d[:, 1], d[:, 0])
+        if not self.closed:
+            rel = (ang - self.start) % (2 * math.pi)
+            lo, hi = margin / self.radius, self.span - margin / self.radius
+            # a point past either end goes to the nearer end
+            past = rel > self.span + (2 * math.pi - self.span) / 2
+            rel = np.where(past, lo, np.clip(rel, lo, hi))
+            ang = self.start + rel
+        return self.centre + self.radius * np.stack([np.cos(ang), np.sin(ang)], axis=1)
+
+
+def _arcs(face, to2d) -> list[_Arc]:
+    out = []
+    for e in face.Edges():
+        if e.geomType() != "CIRCLE":
+            continue
+        c = to2d(np.array([e.arcCenter().toTuple()]))[0]
+        r = float(e.radius())
+        if e.IsClosed():
+            out.append(_Arc(c, r, 0.0, 2 * math.pi, True))
+            continue
+        s, m, f = (
+            to2d(np.array([e.positionAt(x).toTuple()]))[0] - c for x in (0.0, 0.5, 1.0)
+        )
+        a0, am, a1 = (math.atan2(q[1], q[0]) for q in (s, m, f))
+        span = (a1 - a0) % (2 * math.pi)
+        if (am - a0) % (2 * math.pi) > span:  # the arc runs the other way round
+            a0, span = a1, 2 * math.pi - span
+        out.append(_Arc(c, r, a0, span, False))
+    return out
+
+
+def _project_onto(arcs: list[_Arc], margin: float):
+    def project(p: np.ndarray) -> np.ndarray:
+        d = np.stack([a.distance(p) for a in arcs], axis=1)
+        which = np.argmin(d, axis=1)
+        out = p.copy()
+        for k, a in enumerate(arcs):
+            sel = which == k
+            if sel.any():
+                out[sel] = a.project(p[sel], margin)
+        return out
+
+    return project
+
+
+def _ghosts(arcs: list[_Arc], raster: _Raster, h: float):
+    """The neighbouring face unfolded across the arcs: rows h and 2h beyond each arc sample.
+
+    The cylinder (or cone, or sphere) on the other side of a circular edge
+    starts its lattice from the edge's samples, one row about h away from
+    the edge; unfolded into the plane those rows stand beyond the arc.
+    """
+    sides = []
+    for a in arcs:
+        mid = a.start + a.span / 2
+        probe = a.centre + (a.radius - 0.5 * h) * np.array([[math.cos(mid), math.sin(mid)]])
+        sides.append(1.0 if raster(probe)[0] else -1.0)  # +1: face inside, unfold outwards
+
+    def ghosts(p: np.ndarray) -> np.ndarray:
+        if p.shape[0] == 0:
+            return np.empty((0, 2))
+        d = np.stack([a.distance(p) for a in arcs], axis=1)
+        which = np.argmin(d, axis=1)
+        out = []
+        for k, a in enumerate(arcs):
+            q = p[which == k]
+            w = q - a.centre
+            w /= np.linalg.norm(w, axis=1)[:, None]
+            for j in (1.0, 2.0):
+                out.append(a.centre + (a.radius + sides[k] * j * h) * w)
+        return np.vstack(out)
+
+    return ghosts
+
+
+def _plane_frame(face):
+    n = np.array(face.normalAt().toTuple())
+    k = int(np.argmax(np.abs(n)))
+    if abs(abs(n[k]) - 1.0) < 1e-12:
+        u = np.eye(3)[(k + 1) % 3]
+        v = np.eye(3)[(k + 2) % 3]
+    else:
+        u = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
+        u /= np.linalg.norm(u)
+        v = np.cross(n, u)
+    o = np.array(face.Center().toTuple())
+    o = n * float(n @ o)  # the plane's point nearest the origin: parallel faces share u, v
+    return o, u, v, n
+
+
+def repair_planar_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
+    """Repair the boundary layer of every planar face bounded by circular arcs.
+
+    The arcs' samples slide along them (the cylinders they bound are laid
+    out from them afterwards, :func:`lattice_cylinder_faces`); corners stay.
+    Returns one report per repaired face.
+    """
+    reports = []
+    tol = 1e-7 * size
+    for fi, face in enumerate(occ.Faces()):
+        if face.geomType() != "PLANE":
+            continue
+        o, u, v, n = _plane_frame(face)
+
+        def to2d(p, o=o, u=u, v=v):
+            q = np.asarray(p, dtype=np.float64) - o
+            return np.stack([q @ u, q @ v], axis=1)
+
+        arcs = _arcs(face, to2d)
+        if not arcs:
+            continue
+        on_plane = np.abs((s.points - o) @ n) < tol
+        seg = _boundary_segments(face, to2d, h / 20)
+        raster = _Raster(seg, h / RASTER)
+        cand = np.flatnonzero(on_plane)
+        uv = to2d(s.points[cand])
+        # the face's samples: inside it, or on its boundary (the tessellation's
+        # boundary is a polyline: arc samples sit a sagitta off it)
+        mine = raster(uv) | (_segment_distance(uv, seg, h / 100) < 0.1 * h)
+        idx = cand[mine]
+        uv = uv[mine]
+        # a fixed order (by position) so that congruent faces get the same answer
+        order = np.lexsort((np.round(uv[:, 1] / h, 6), np.round(uv[:, 0] / h, 6)))
+        idx, uv = idx[order], uv[order]
+        near_arc = np.min(np.stack([a.distance(uv) for a in arcs], axis=1), axis=1)
+        corners = _corner_points(face, to2d)
+        at_corner = (
+            cKDTree(corners).query(uv)[0] < tol if corners.shape[0] else np.zeros(len(uv), bool)
+        )
+        feat = s.on_feature[idx]
+        slide = feat & (near_arc < tol) & ~at_corner
+        free = ~feat & (near_arc < LAYER * h)
+        if not (free.any() or slide.any()):
+            continue
+        r = repair(
+            uv,
+            free,
+            h,
+            slide=slide,
+            project=_project_onto(arcs, 0.3 * h),
+            inside=raster,
+            ghosts=_ghosts(arcs, raster, h),
+        )
+        src_all = idx
+        src = np.where(r.origin >= 0, src_all[np.maximum(r.origin, 0)], -1)
+        moved = src >= 0
+        pts3 = o + r.uv[:, :1] * u + r.uv[:, 1:] * v
+        s.replace(
+            idx,
+            pts3,
+            np.where(moved, s.line_id[np.maximum(src, 0)], -3),
+            np.where(moved, s.face_id[np.maximum(src, 0)], fi),
+            np.where(moved, s.on_feature[np.maximum(src, 0)], False),
+        )
+        reports.append(
+            {
+                "face": fi,
+                "kind": "plane",
+                "samples": int(idx.size),
+                "added": int((~moved).sum()),
+                "removed": int(idx.size - moved.sum()),
+                "bad": r.bad,
+                "worst": r.worst,
+            }
+        )
+    return reports
+
+
+def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
+    """Lay every full cylinder out as the lattice its two rims span.
+
+    The scan rows of a cylinder are circles; sampled by arc length from the
+    seam they line up with the rims' samples only when their count happens
+    to match.  Here each cylinder whose two rims carry the same angles gets
+    ``round(H / h) - 1`` rows evenly between them (the sections by planes
+    spaced ``H / round(H / h)`` along the axis), each with the rims' angles:
+    a rectangular lattice on the unrolled cylinder.
+    """
+    reports = []
+    tol = 1e-7 * size
+    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
+    for fi, face in enumerate(occ.Faces()):
+        if face.geomType() != "CYLINDER":
+            continue
+        umin, umax, vmin, vmax = face._uvBounds()
+        if abs((umax - umin) - 2 * math.pi) > 1e-9:
+            continue  # a partial cylinder (a fillet)
+        cyl = face._geomAdaptor().Cylinder()
+        pos = cyl.Position()
+        o = np.array(pos.Location().Coord())
+        ex = np.array(pos.XDirection().Coord())
+        ey = np.array(pos.YDirection().Coord())
+        ez = np.array(pos.Direction().Coord())
+        radius = cyl.Radius()
+        q = s.points - o
+        axial = q @ ez
+        radial = np.linalg.norm(q - axial[:, None] * ez, axis=1)
+        mine = (np.abs(radial - radius) < tol) & (axial > vmin - tol) & (axial < vmax + tol)
+        idx = np.flatnonzero(mine)
+        ang = np.arctan2(q[idx] @ ey, q[idx] @ ex) % (2 * math.pi)
+        rim_lo = s.on_feature[idx] & (np.abs(axial[idx] - vmin) < tol)
+        rim_hi = s.on_feature[idx] & (np.abs(axial[idx] - vmax) < tol)
+        a_lo, a_hi = np.sort(ang[rim_lo]), np.sort(ang[rim_hi])
+        if a_lo.size < 3 or a_lo.size != a_hi.size or np.abs(a_lo - a_hi).max() > 1e-9:
+            continue
+        rows = max(1, round((vmax - vmin) / h))
+        z = vmin + (vmax - vmin) * np.arange(1, rows) / rows
+        zz = np.repeat(z, a_lo.size)
+        aa = np.tile(a_lo, z.size)
+        pts3 = o + zz[:, None] * ez + radius * (np.cos(aa)[:, None] * ex + np.sin(aa)[:, None] * ey)
+        drop = idx[~(rim_lo | rim_hi)]
+        s.replace(
+            drop,
+            pts3,
+            line + np.repeat(np.arange(z.size), a_lo.size),
+            np.full(zz.size, fi),
+            np.zeros(zz.size, dtype=bool),
+        )
+        line += z.size
+        reports.append(
+            {"face": fi, "kind": "cylinder lattice", "rows": int(z.size), "columns": int(a_lo.size)}
+        )
+    return reports
+
+
+def _corner_points(face, to2d) -> np.ndarray:
+    pts = [v.toTuple() for v in face.Vertices()]
+    return to2d(np.array(pts)) if pts else np.empty((0, 2))
+
+
+def _segment_distance(p: np.ndarray, seg: np.ndarray, step: float) -> np.ndarray:
+    """Distance from each point to the segments, within ``step`` (a resampling that fine)."""
+    a, b = seg[:, 0], seg[:, 1]
+    length = np.linalg.norm(b - a, axis=1)
+    counts = np.maximum(1, np.ceil(length / step).astype(np.int64))
+    which = np.repeat(np.arange(seg.shape[0]), counts + 1)
+    frac = (np.arange(which.size) - np.repeat(np.cumsum(counts + 1) - counts - 1, counts + 1)) / (
+        np.repeat(counts, counts + 1)
+    )
+    dense = a[which] + frac[:, None] * (b - a)[which]
+    d, _ = cKDTree(dense).query(p)
+    return d
