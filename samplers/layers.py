@@ -126,9 +126,7 @@ def _arcs(face, to2d) -> list[_Arc]:
         if e.IsClosed():
             out.append(_Arc(c, r, 0.0, 2 * math.pi, True))
             continue
-        s, m, f = (
-            to2d(np.array([e.positionAt(x).toTuple()]))[0] - c for x in (0.0, 0.5, 1.0)
-        )
+        s, m, f = (to2d(np.array([e.positionAt(x).toTuple()]))[0] - c for x in (0.0, 0.5, 1.0))
         a0, am, a1 = (math.atan2(q[1], q[0]) for q in (s, m, f))
         span = (a1 - a0) % (2 * math.pi)
         if (am - a0) % (2 * math.pi) > span:  # the arc runs the other way round
@@ -204,6 +202,7 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     Returns one report per repaired face.
     """
     reports = []
+    done: dict[tuple, object] = {}
     tol = 1e-7 * size
     for fi, face in enumerate(occ.Faces()):
         if face.geomType() != "PLANE":
@@ -240,15 +239,24 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         free = ~feat & (near_arc < LAYER * h)
         if not (free.any() or slide.any()):
             continue
-        r = repair(
-            uv,
-            free,
-            h,
-            slide=slide,
-            project=_project_onto(arcs, 0.3 * h),
-            inside=raster,
-            ghosts=_ghosts(arcs, raster, h),
+        # congruent faces (a prism's two ends) get one answer: their rims must agree
+        key = (
+            uv.round(12).tobytes(),
+            slide.tobytes(),
+            free.tobytes(),
+            tuple((tuple(a.centre.round(12)), round(a.radius, 12), a.closed) for a in arcs),
         )
+        if key not in done:
+            done[key] = repair(
+                uv,
+                free,
+                h,
+                slide=slide,
+                project=_project_onto(arcs, 0.3 * h),
+                inside=raster,
+                ghosts=_ghosts(arcs, raster, h),
+            )
+        r = done[key]
         src_all = idx
         src = np.where(r.origin >= 0, src_all[np.maximum(r.origin, 0)], -1)
         moved = src >= 0
@@ -348,3 +356,96 @@ def _segment_distance(p: np.ndarray, seg: np.ndarray, step: float) -> np.ndarray
     dense = a[which] + frac[:, None] * (b - a)[which]
     d, _ = cKDTree(dense).query(p)
     return d
+
+
+def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
+    """Lay every full cone with a sampled rim out in rings that keep their columns.
+
+    Scan rows of a cone are circles of decreasing radius; sampled by arc
+    length each on its own they stagger, and the staggered rows make
+    near-equilateral triangles everywhere.  Here the rows are the circles
+    ``round(L / h) - 1`` evenly spaced slant steps from the rim towards the
+    apex (sections by planes across the axis), and every row keeps the
+    angles of the row before it -- the rim's own samples first.  Where two
+    neighbouring columns come closer than 0.75 h along a row, one of them
+    ends (the one whose end leaves the narrower merged gap, at most 1.6 h):
+    the cells stay near-rectangles, with a pentagon where a column ends.
+    """
+    reports = []
+    tol = 1e-7 * size
+    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
+    for fi, face in enumerate(occ.Faces()):
+        if face.geomType() != "CONE":
+            continue
+        umin, umax, vmin, vmax = face._uvBounds()
+        if abs((umax - umin) - 2 * math.pi) > 1e-9:
+            continue
+        cone = face._geomAdaptor().Cone()
+        pos = cone.Position()
+        apex = np.array(cone.Apex().Coord())
+        loc = np.array(pos.Location().Coord())
+        if np.linalg.norm(loc - apex) < tol:
+            continue
+        axis = (loc - apex) / np.linalg.norm(loc - apex)
+        ex = np.array(pos.XDirection().Coord())
+        ey = np.cross(axis, ex)
+        tan_a = math.tan(abs(cone.SemiAngle()))
+        sin_a = math.sin(abs(cone.SemiAngle()))
+        q = s.points - apex
+        along = q @ axis
+        radial = np.linalg.norm(q - along[:, None] * axis, axis=1)
+        on = np.abs(radial - along * tan_a) < tol * 10
+        # the rim: feature samples of the face at its largest distance from the apex
+        cand = np.flatnonzero(on & (along > tol))
+        if cand.size == 0:
+            continue
+        top = along[cand].max()
+        rim = cand[s.on_feature[cand] & (np.abs(along[cand] - top) < tol * 10)]
+        if rim.size < 3:
+            continue  # the rim is a smooth edge (cone_tip): left to the scan rows
+        slant = top / math.cos(abs(cone.SemiAngle()))
+        rows = max(1, round(slant / h))
+        t = slant / rows
+        ang = np.sort(np.arctan2(q[rim] @ ey, q[rim] @ ex) % (2 * math.pi))
+        pts, ids = [], []
+        for j in range(1, rows):
+            rho = slant - j * t
+            ang = _end_columns(ang, rho * sin_a, t)
+            if ang.size < 3:
+                break
+            z = rho * math.cos(abs(cone.SemiAngle()))
+            rr = rho * sin_a
+            pts.append(
+                apex + z * axis + rr * (np.cos(ang)[:, None] * ex + np.sin(ang)[:, None] * ey)
+            )
+            ids.append(np.full(ang.size, line))
+            line += 1
+        drop = cand[~s.on_feature[cand]]
+        new = np.vstack(pts) if pts else np.empty((0, 3))
+        s.replace(
+            drop,
+            new,
+            np.concatenate(ids) if ids else np.empty(0, np.int64),
+            np.full(new.shape[0], fi),
+            np.zeros(new.shape[0], dtype=bool),
+        )
+        reports.append({"face": fi, "kind": "cone rings", "rows": len(pts), "samples": len(new)})
+    return reports
+
+
+def _end_columns(ang: np.ndarray, scale: float, t: float) -> np.ndarray:
+    """Columns (angles) left on a row of radius ``scale`` after ending the crowded ones."""
+    ang = ang.copy()
+    while ang.size > 3:
+        gap = np.diff(np.r_[ang, ang[0] + 2 * math.pi]) * scale  # gap k: column k to k + 1
+        k = int(np.argmin(gap))
+        if gap[k] >= 0.75 * t:
+            break
+        m = ang.size
+        merged_k = gap[k - 1] + gap[k]  # ending column k
+        merged_k1 = gap[k] + gap[(k + 1) % m]  # ending column k + 1
+        end = k if merged_k <= merged_k1 else (k + 1) % m
+        if min(merged_k, merged_k1) > 1.6 * t and gap[k] >= 0.5 * t:
+            break  # ending one would leave too wide a cell; keep both while they are apart
+        ang = np.delete(ang, end)
+    return ang

@@ -78,6 +78,16 @@ class _Problem:
         self.period = period
         self.ghosts = ghosts
 
+    def watch(self) -> np.ndarray:
+        """Samples whose triangles are judged: the movable ones and fixed ones
+        within 1.5 h of them (a removal may open a bad triangle among those)."""
+        move = self.free | self.slide
+        out = move.copy()
+        if move.any() and (~move).any():
+            d, _ = cKDTree(self.uv[move]).query(self.uv[~move])
+            out[~move] = d < 1.5 * self.h
+        return out
+
     def copy(self) -> _Problem:
         c = _Problem.__new__(_Problem)
         c.__dict__.update(self.__dict__)
@@ -134,10 +144,8 @@ def _energy(prob: _Problem, subset=None, active=None):
     if tri.shape[0] == 0:
         return 0.0, grad, np.empty(0), tri
     tri = tri[(of[tri] >= 0).all(axis=1)]  # triangles on a ghost are not the face's
-    if active is None:
-        active = prob.free | prob.slide
-    else:
-        active = active & (prob.free | prob.slide)
+    watch = prob.watch()
+    active = watch if active is None else active & watch
     tri = tri[active[of[tri]].any(axis=1)]
     if tri.shape[0] == 0:
         return 0.0, grad, np.empty(0), tri
@@ -171,9 +179,14 @@ def _energy(prob: _Problem, subset=None, active=None):
     # the lattice of the face on the other side starts from them
     both = prob.slide[of[tri[:, _EDGES[:, 0]]]] & prob.slide[of[tri[:, _EDGES[:, 1]]]]
     if both.any():
-        gap = np.where(
-            both, np.maximum(0.0, GAP[0] * h - length) - np.maximum(0.0, length - GAP[1] * h), 0.0
-        ) / h
+        gap = (
+            np.where(
+                both,
+                np.maximum(0.0, GAP[0] * h - length) - np.maximum(0.0, length - GAP[1] * h),
+                0.0,
+            )
+            / h
+        )
         energy += 5.0 * float((gap**2).sum()) / 2.0
         for col in range(3):
             push(np.full(tri.shape[0], col), -10.0 * gap[:, col] / h)
@@ -185,9 +198,11 @@ def _energy(prob: _Problem, subset=None, active=None):
     energy += float((wide**2).sum())
     # a simple gradient for the radius term: pull the triangle's corners to its centroid
     cen = p.mean(axis=1)
-    pull = (2 * wide / h)[:, None, None] * (p - cen[:, None, :]) / np.maximum(radius, 1e-300)[
-        :, None, None
-    ]
+    pull = (
+        (2 * wide / h)[:, None, None]
+        * (p - cen[:, None, :])
+        / np.maximum(radius, 1e-300)[:, None, None]
+    )
     np.add.at(gp, tri.ravel(), pull.reshape(-1, 2))
     real = of >= 0
     np.add.at(grad, of[real], gp[real])
@@ -333,7 +348,6 @@ def repair(
             region = _local(prob, centre, 5.0 * prob.h)
             before = _status(prob, *region)
             cands: list[tuple[str, object]] = [("del", int(v)) for v in tri if prob.free[v]]
-            cands += [("del", int(v)) for v in tri if prob.slide[v]]
             cands.append(("add", centre))
             for kind, arg in cands:
                 key = (kind, arg) if kind == "del" else (kind, tuple(np.round(arg, 12)))

@@ -325,8 +325,8 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float):
             n2 = np.array(uniq[1].normalAt(mid).toTuple())
             if float(n1 @ n2) > cos_lim:
                 continue  # smooth edge (fillet tangency) or seam: sampled by scan lines
-        elif len(uniq) != 1:
-            continue  # a seam edge (one face on both sides)
+        elif len(uniq) != 1 or len(adj) != 1:
+            continue  # a seam edge (one face on both sides): sampled by scan lines
         m = max(1, int(round(length / step)))
         for j in range(1, m):
             edge_pts.append(np.array(edge.positionAt(j / m, mode="length").toTuple()))
@@ -548,11 +548,17 @@ def scan(
         on_feature = np.r_[on_feature, np.zeros(fill.shape[0], dtype=bool)]
     reports: list[dict] = []
     if repair:
-        from .layers import Samples, lattice_cylinder_faces, repair_planar_faces
+        from .layers import (
+            Samples,
+            lattice_cone_faces,
+            lattice_cylinder_faces,
+            repair_planar_faces,
+        )
 
         bag = Samples(points, line_id, face_id, on_feature)
         reports = repair_planar_faces(occ, bag, h, size)
         reports += lattice_cylinder_faces(occ, bag, h, size)
+        reports += lattice_cone_faces(occ, bag, h, size)
         points, line_id, face_id, on_feature = (
             bag.points,
             bag.line_id,

@@ -1,0 +1,77 @@
+"""samplers.repair: Condition III-ii restored around a circle, deterministically."""
+
+import numpy as np
+import pytest
+from scipy.spatial import Delaunay, cKDTree
+
+from samplers.repair import BAD, repair
+
+
+def hole_layout(h, radius, centre):
+    """Square lattice with a circular hole: lattice points in the hole dropped,
+    the circle sampled uniformly about h apart (the scan sampler's start)."""
+    xs = np.arange(-0.5, 0.5 + 1e-9, h)
+    g = np.stack(np.meshgrid(xs, xs), -1).reshape(-1, 2)
+    r = np.linalg.norm(g - centre, axis=1)
+    g = g[r > radius + 0.75 * h]
+    m = int(round(2 * np.pi * radius / h))
+    t = 2 * np.pi * np.arange(m) / m
+    rim = centre + radius * np.stack([np.cos(t), np.sin(t)], 1)
+    return np.vstack([g, rim]), np.r_[np.zeros(len(g), bool), np.ones(m, bool)]
+
+
+def ratios(uv, keep):
+    tri = Delaunay(uv).simplices
+    tri = tri[keep(uv[tri].mean(axis=1))]
+    p = uv[tri]
+    e = np.sort(np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2), axis=1)
+    return e[:, 1] / e[:, 2]
+
+
+@pytest.mark.parametrize("h,radius,centre", [(0.05, 0.25, (0.01, 0.02)), (0.04, 0.18, (0.0, 0.0))])
+def test_repair_around_a_hole_meets_condition_iii(h, radius, centre):
+    c = np.array(centre)
+    uv, on_rim = hole_layout(h, radius, c)
+    dist = np.linalg.norm(uv - c, axis=1)
+    before = ratios(uv, lambda q: np.linalg.norm(q - c, axis=1) > radius)
+    assert before.max() > np.sqrt(3) / 2  # the start breaks the condition
+
+    def project(q):
+        w = q - c
+        return c + radius * w / np.linalg.norm(w, axis=1)[:, None]
+
+    def inside(q):
+        return np.linalg.norm(q - c, axis=1) > radius
+
+    free = ~on_rim & (dist < radius + 2.5 * h)
+    r = repair(uv, free, h, slide=on_rim, project=project, inside=inside)
+    assert r.bad == 0
+    after = ratios(r.uv, inside)
+    assert after.max() < BAD < np.sqrt(3) / 2
+    # samples that were neither free nor sliding did not move
+    fixed = ~free & ~on_rim
+    kept = r.origin >= 0
+    moved_from = r.origin[kept]
+    still = fixed[moved_from]
+    np.testing.assert_array_equal(r.uv[kept][still], uv[moved_from[still]])
+    # sliding samples are on the circle, nobody is closer than h / 4
+    rim_now = kept & on_rim[np.maximum(r.origin, 0)]
+    np.testing.assert_allclose(np.linalg.norm(r.uv[rim_now] - c, axis=1), radius, rtol=1e-12)
+    d, _ = cKDTree(r.uv).query(r.uv, 2)
+    assert d[:, 1].min() >= 0.25 * h
+    # the same input gives the same output
+    again = repair(uv, free, h, slide=on_rim, project=project, inside=inside)
+    np.testing.assert_array_equal(again.uv, r.uv)
+
+
+def test_sliding_without_projection_is_an_error():
+    uv = np.random.default_rng(0).random((10, 2))
+    with pytest.raises(ValueError, match="project is required when some samples slide"):
+        repair(uv, np.zeros(10, bool), 0.1, slide=np.ones(10, bool))
+
+
+def test_nothing_to_move_returns_the_input():
+    uv = np.random.default_rng(1).random((20, 2))
+    r = repair(uv, np.zeros(20, bool), 0.1)
+    np.testing.assert_array_equal(r.uv, uv)
+    np.testing.assert_array_equal(r.origin, np.arange(20))
