@@ -5,9 +5,12 @@ truth-mesh checks (watertight/manifold, Euler characteristic against the
 B-rep's), distance of the samples to the CAD surface (OCC's exact
 BRepExtrema distance, as a multiple of the shape's size), coverage (largest
 distance from the truth surface to the nearest sample, in h), the closest
-pair (in h), nearest-neighbour spacing, Condition III by the local tangent
-Delaunay check, seconds to build and to sample, and the reconstruction's
-open/overloaded edges and Euler characteristic next to the expected ones.
+pair (in h), nearest-neighbour spacing, Condition III by the validators'
+geodesic check (``validators.conditions.sample_conditions``: DT_M on the
+refined truth with the samples inserted; worst ratio, share of samples in a
+violating triangle, largest degree), seconds to build and to sample, and the
+reconstruction's open/overloaded edges and Euler characteristic next to the
+expected ones.
 
 Run: ``.venv/bin/python bench/samplers_report.py [--out out/samplers.json]``.
 """
@@ -31,7 +34,7 @@ from samplers.scanline import scan  # noqa: E402
 from sr33 import reconstruct  # noqa: E402
 from sr33.io import write_text  # noqa: E402
 from validators import mesh_stats  # noqa: E402
-from validators.conditions import local_delaunay  # noqa: E402
+from validators.conditions import sample_conditions  # noqa: E402
 from validators.fidelity import surface_points  # noqa: E402
 
 
@@ -91,7 +94,10 @@ def main(argv=None) -> int:
             ]
         )
         on = float(surface_distance(s.solid, pick).max() / s.size)
-        ld = local_delaunay(p)
+        t0 = time.perf_counter()
+        cond = sample_conditions(p, s.truth_vertices, s.truth_triangles)
+        tc = time.perf_counter() - t0
+        violating = int(np.count_nonzero(~(cond.worst_ratio < np.sqrt(3) / 2)))
         rec = reconstruct(p, 33)
         st = mesh_stats(rec.triangles, rec.vertices.shape[0])
         e = s.expected
@@ -103,8 +109,11 @@ def main(argv=None) -> int:
             "nn_max": float(nn.max()),
             "coverage_h": cover,
             "surface_distance_over_size": on,
-            "condition_iii_worst_ratio": ld.max_ratio,
-            "max_degree": ld.max_degree,
+            "condition_iii_worst_ratio": cond.max_ratio,
+            "condition_iii_violating_samples": violating,
+            "max_degree": cond.max_degree,
+            "conditions_s": tc,
+            "repairs": r.meta.get("repairs", []),
             "build_s": tb,
             "sample_s": ts,
             "truth": truth.as_dict(),
@@ -121,8 +130,8 @@ def main(argv=None) -> int:
         )
         print(
             f"{name:<16}{len(p):>7}{h:>7.3f}{nn.min():>8.2f}/{np.median(nn):.2f}/{nn.max():.2f}"
-            f"{nn.min():>7.2f}{cover:>7.2f}{on:>9.1e}{ld.max_ratio:>7.3f}"
-            f"{100 * len(ld.violations()) / len(p):>5.1f}%{ld.max_degree:>5}"
+            f"{nn.min():>7.2f}{cover:>7.2f}{on:>9.1e}{cond.max_ratio:>7.3f}"
+            f"{100 * violating / len(p):>5.1f}%{cond.max_degree:>5}"
             f"{tb:>7.2f}{ts:>6.2f} | χ{e.euler:>3} b{e.boundary_loops} g{e.genus} |"
             f" {st.open_edges:>5}{st.overloaded_edges:>5}{st.euler:>6}  {'yes' if match else 'NO'}"
         )

@@ -30,6 +30,13 @@ a CadQuery shape:
 * where the rows leave a gap (planes grazing a face: the poles of a sphere),
   extra samples are projected onto the surface until every point of it is
   within h of a sample (their ``line_id`` is -2);
+* where rows meet a circular sharp edge (a hole, a disk's rim, the cut of
+  a scoop) the boundary layer of each planar face is repaired until its
+  Delaunay triangles meet Condition III-ii (:mod:`samplers.layers`,
+  :mod:`samplers.repair`); full cylinders are then laid out as the lattice
+  their two rims span, and cones with a sampled rim in rings that keep the
+  rim's columns and end crowded ones towards the apex (``repair=False``
+  keeps the plain scan rows);
 * optional Gaussian jitter (σ·h) and dropout, both seeded.
 
 Every sample before jitter lies on the CAD surface (points are evaluated on
@@ -225,7 +232,9 @@ def _chains(edges, tol: float) -> list[tuple[list[tuple[Any, bool]], bool]]:
     return chains
 
 
-def _sample_chain(chain, closed: bool, step: float, anchor: np.ndarray) -> np.ndarray:
+def _sample_chain(
+    chain, closed: bool, step: float, anchor: np.ndarray, axis_steps=None
+) -> np.ndarray:
     """Samples along a chain of edges, about ``step`` apart.
 
     A straight segment is sampled where its coordinate along its own
@@ -242,6 +251,13 @@ def _sample_chain(chain, closed: bool, step: float, anchor: np.ndarray) -> np.nd
         b = np.array(e.endPoint().toTuple())
         length = float(np.linalg.norm(b - a))
         u = (b - a) / length
+        if axis_steps is not None:
+            # a row along a coordinate axis steps like the planes across that
+            # axis (the extent over a whole number of steps), so that its
+            # samples meet the corner and edge samples of the faces it crosses
+            k = int(np.argmax(np.abs(u)))
+            if abs(abs(u[k]) - 1.0) < 1e-12:
+                step = float(axis_steps[k])
         c0 = float((a - anchor) @ u)
         first = math.ceil(c0 / step - 1e-9)
         last = math.floor((c0 + length) / step + 1e-9)
@@ -499,6 +515,11 @@ def scan(
         [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
     )
 
+    extent3 = hi - lo
+    # per coordinate axis: r times the spacing nearest h that divides the extent
+    axis_steps = ratio * np.array(
+        [e / max(1, round(e / h)) if e > 0 else h for e in extent3.tolist()]
+    )
     pts, fids, feature_curve = _feature_samples(occ, EDGE_STEP * h, sharp_degrees, tol)
     n_feature = len(pts)
     line_ids = [-1] * n_feature
@@ -527,7 +548,7 @@ def scan(
             origin = d * t
             edges = _section(face, tuple(origin), tuple(d))
             for chain, closed in _chains(edges, max(tol, 1e-9)):
-                p = _sample_chain(chain, closed, ratio * hf, lo)
+                p = _sample_chain(chain, closed, ratio * hf, lo, axis_steps)
                 pts.extend(p)
                 fids.extend([fi] * len(p))
                 line_ids.extend([line] * len(p))

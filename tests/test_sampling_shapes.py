@@ -64,3 +64,33 @@ def test_same_arguments_identical_arrays(sampled, name):
     again = scan(shapes.build(name))
     assert np.array_equal(r.points, again.points)
     assert np.array_equal(r.face_id, again.face_id)
+
+
+def test_box_hole_default_sampling_meets_condition_iii_geodesically(sampled):
+    """The rows meet the hole's rims through the repaired boundary layer: every
+    intrinsic Delaunay triangle (geodesics on the refined truth) has its two
+    shorter edges below sqrt(3)/2 of its longest, every degree is at most 33."""
+    pytest.importorskip("potpourri3d")
+    from validators.conditions import sample_conditions
+
+    s, r = sampled["box_hole"]
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    assert rep.max_ratio < np.sqrt(3) / 2
+    assert rep.max_degree <= 33
+    assert [row[1] for row in rep.table()[:2]] == ["pass", "pass"]
+
+
+def test_repairs_are_reported_and_congruent_ends_agree(sampled):
+    s, r = sampled["box_hole"]
+    planes = [x for x in r.meta["repairs"] if x["kind"] == "plane"]
+    assert len(planes) == 2 and planes[0]["bad"] == planes[1]["bad"] == 0
+    # the hole's wall is the lattice its two (identical) rims span
+    wall = [x for x in r.meta["repairs"] if x["kind"] == "cylinder lattice"]
+    assert len(wall) == 1 and wall[0]["rows"] == round(s.params["height"] / r.meta["spacing"]) - 1
+    p = r.points
+    top = p[np.isclose(p[:, 2], 0.25) & np.isclose(np.linalg.norm(p[:, :2], axis=1), 0.25)]
+    bottom = p[np.isclose(p[:, 2], -0.25) & np.isclose(np.linalg.norm(p[:, :2], axis=1), 0.25)]
+    key = np.lexsort
+    np.testing.assert_allclose(
+        top[key(top[:, :2].T[::-1])][:, :2], bottom[key(bottom[:, :2].T[::-1])][:, :2], atol=1e-12
+    )
