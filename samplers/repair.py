@@ -264,7 +264,7 @@ def repair(
     period: float | None = None,
     ghosts: Callable[[np.ndarray], np.ndarray] | None = None,
     descent_steps: int = 300,
-    max_edits: int = 40,
+    max_edits: int = 80,
 ) -> Repaired:
     """Move, remove or add samples until Condition III-ii holds with a margin.
 
@@ -366,8 +366,9 @@ def repair(
                 break
         if best is None:
             break
-        prob = best[1]  # already relaxed around the edit
+        prob = best[1]
         edits += 1
+        _descend(prob, 60)
         nbad, energy, bad, worst = _status(prob)
     # put the frame back among the untouched samples
     rest = np.setdiff1d(np.arange(n), sub)
