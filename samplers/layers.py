@@ -282,6 +282,17 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     return reports
 
 
+def _full_turns(occ, kind: str):
+    """(index, face) of the faces of a surface type that go all the way round
+    (a partial cylinder is a fillet: its smooth edges are not sampled)."""
+    for fi, face in enumerate(occ.Faces()):
+        if face.geomType() != kind:
+            continue
+        umin, umax, _, _ = face._uvBounds()
+        if abs((umax - umin) - 2 * math.pi) <= 1e-9:
+            yield fi, face
+
+
 def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     """Lay every full cylinder out as the lattice its two rims span.
 
@@ -295,12 +306,8 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
     reports = []
     tol = 1e-7 * size
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
-    for fi, face in enumerate(occ.Faces()):
-        if face.geomType() != "CYLINDER":
-            continue
-        umin, umax, vmin, vmax = face._uvBounds()
-        if abs((umax - umin) - 2 * math.pi) > 1e-9:
-            continue  # a partial cylinder (a fillet)
+    for fi, face in _full_turns(occ, "CYLINDER"):
+        _, _, vmin, vmax = face._uvBounds()
         cyl = face._geomAdaptor().Cylinder()
         pos = cyl.Position()
         o = np.array(pos.Location().Coord())
@@ -374,12 +381,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     reports = []
     tol = 1e-7 * size
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
-    for fi, face in enumerate(occ.Faces()):
-        if face.geomType() != "CONE":
-            continue
-        umin, umax, vmin, vmax = face._uvBounds()
-        if abs((umax - umin) - 2 * math.pi) > 1e-9:
-            continue
+    for fi, face in _full_turns(occ, "CONE"):
         cone = face._geomAdaptor().Cone()
         pos = cone.Position()
         apex = np.array(cone.Apex().Coord())

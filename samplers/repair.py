@@ -398,9 +398,3 @@ def _edited(prob: _Problem, kind: str, arg) -> _Problem:
         trial.slide = np.r_[trial.slide, False]
         trial.origin = np.r_[trial.origin, -1]
     return trial
-
-
-def nearest_gap(uv: np.ndarray) -> float:
-    """Smallest distance between two samples (for reports)."""
-    d, _ = cKDTree(uv).query(uv, 2)
-    return float(d[:, 1].min())
