@@ -361,14 +361,16 @@ def repair(
                 gain = (before[0] - after[0], before[1] - after[1])
                 if gain[0] > 0 or (gain[0] == 0 and gain[1] > 1e-9):
                     if best is None or gain > best[0]:
-                        best = (gain, trial)
+                        best = (gain, trial, centre)
             if best is not None and best[0][0] > 0:
                 break
         if best is None:
             break
         prob = best[1]
         edits += 1
-        _descend(prob, 60)
+        # relax a wider neighbourhood of the edit (a global descent per edit
+        # would make the repair quadratic in the number of samples)
+        _descend(prob, 60, *_local(prob, best[2], 8.0 * prob.h))
         nbad, energy, bad, worst = _status(prob)
     # put the frame back among the untouched samples
     rest = np.setdiff1d(np.arange(n), sub)

@@ -134,6 +134,7 @@ def _cmd_sample(args) -> int:
             jitter=args.jitter,
             dropout=args.dropout,
             seed=args.seed,
+            repair=not args.no_repair,
         )
     except (shapes.ShapeError, scanline.SamplingError) as exc:
         raise InputError(str(exc)) from None
@@ -357,6 +358,11 @@ def build_parser() -> argparse.ArgumentParser:
     sm.add_argument("--jitter", type=float, default=0.0, help="Gaussian noise sigma / h")
     sm.add_argument("--dropout", type=float, default=0.0, help="fraction of samples dropped")
     sm.add_argument("--seed", type=int, default=0)
+    sm.add_argument(
+        "--no-repair",
+        action="store_true",
+        help="plain scan rows: skip the boundary-layer repair at circular edges (faster)",
+    )
     sm.add_argument("-o", "--output", help="points: .ply .xyz .txt .npy .obj .vtp")
     sm.add_argument("--truth", help="also write the ground-truth mesh here")
     sm.add_argument("--meta", help="also write the metadata as JSON here")

@@ -85,3 +85,15 @@ def test_sampled_points_reconstruct_to_the_expected_topology(tmp_path, capsys):
     s = mesh_stats(f, v.shape[0])
     assert (s.open_edges, s.overloaded_edges, s.euler, s.components) == (0, 0, 0, 1)
     assert np.unique(f).shape[0] == read_points(pts).shape[0]
+
+
+def test_no_repair_keeps_the_plain_scan_rows(tmp_path):
+    from samplers import shapes
+    from samplers.scanline import scan
+
+    out = tmp_path / "p.xyz"
+    argv = ["sample", "cylinder", "--spacing", "0.1", "-o", str(out)]
+    assert main([*argv, "--no-repair"]) == 0
+    plain = scan(shapes.build("cylinder"), 0.1, repair=False)
+    np.testing.assert_allclose(read_points(out), plain.points, rtol=0, atol=1e-12)
+    assert plain.meta["repairs"] == []
