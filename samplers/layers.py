@@ -156,11 +156,7 @@ def _ghosts(arcs: list[_Arc], raster: _Raster, h: float):
     starts its lattice from the edge's samples, one row about h away from
     the edge; unfolded into the plane those rows stand beyond the arc.
     """
-    sides = []
-    for a in arcs:
-        mid = a.start + a.span / 2
-        probe = a.centre + (a.radius - 0.5 * h) * np.array([[math.cos(mid), math.sin(mid)]])
-        sides.append(1.0 if raster(probe)[0] else -1.0)  # +1: face inside, unfold outwards
+    sides = _arc_sides(arcs, raster, h)  # +1: face inside, unfold outwards
 
     def ghosts(p: np.ndarray) -> np.ndarray:
         if p.shape[0] == 0:
@@ -177,6 +173,37 @@ def _ghosts(arcs: list[_Arc], raster: _Raster, h: float):
         return np.vstack(out)
 
     return ghosts
+
+
+def _arc_sides(arcs: list[_Arc], raster: _Raster, h: float) -> list[float]:
+    """Per arc, +1 when the face lies inside its circle, -1 when outside."""
+    sides = []
+    for a in arcs:
+        mid = a.start + a.span / 2
+        probe = a.centre + (a.radius - 0.5 * h) * np.array([[math.cos(mid), math.sin(mid)]])
+        sides.append(1.0 if raster(probe)[0] else -1.0)
+    return sides
+
+
+def _clamp(arcs: list[_Arc], raster: _Raster, h: float):
+    """Keep free samples on the face side of every arc, at least h / 4 from it."""
+    sides = _arc_sides(arcs, raster, h)
+
+    def clamp(p: np.ndarray) -> np.ndarray:
+        out = p.copy()
+        for a, side in zip(arcs, sides):
+            w = out - a.centre
+            r = np.linalg.norm(w, axis=1)
+            ang = (np.arctan2(w[:, 1], w[:, 0]) - a.start) % (2 * math.pi)
+            within = a.closed | (ang <= a.span)
+            inward = side * (a.radius - r)  # distance into the face from the arc
+            bad = within & (inward < 0.25 * h) & (r > 1e-12)
+            if bad.any():
+                target = a.radius - side * 0.25 * h
+                out[bad] = a.centre + w[bad] / r[bad, None] * target
+        return out
+
+    return clamp
 
 
 def _plane_frame(face):
@@ -255,6 +282,7 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
                 project=_project_onto(arcs, 0.3 * h),
                 inside=raster,
                 ghosts=_ghosts(arcs, raster, h),
+                clamp=_clamp(arcs, raster, h),
             )
         r = done[key]
         src_all = idx

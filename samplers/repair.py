@@ -67,7 +67,7 @@ class Repaired:
 class _Problem:
     """Samples with their roles, ghost copies for a periodic domain."""
 
-    def __init__(self, uv, free, slide, project, inside, h, period, ghosts=None):
+    def __init__(self, uv, free, slide, project, inside, h, period, ghosts=None, clamp=None):
         self.uv = np.asarray(uv, dtype=np.float64).copy()
         self.free = np.asarray(free, dtype=bool).copy()
         self.slide = np.asarray(slide, dtype=bool).copy()
@@ -77,6 +77,7 @@ class _Problem:
         self.h = h
         self.period = period
         self.ghosts = ghosts
+        self.clamp = clamp
 
     def watch(self) -> np.ndarray:
         """Samples whose triangles are judged: the movable ones and fixed ones
@@ -231,6 +232,8 @@ def _descend(prob: _Problem, steps: int, subset=None, active=None) -> None:
         prob.uv[move] -= (STEP * h / g) * grad[move]
         if prob.slide.any():
             prob.uv[prob.slide] = prob.project(prob.uv[prob.slide])
+        if prob.clamp is not None and prob.free.any():
+            prob.uv[prob.free] = prob.clamp(prob.uv[prob.free])
         if prob.period is not None:
             prob.uv[:, 0] %= prob.period
 
@@ -263,6 +266,7 @@ def repair(
     inside: Callable[[np.ndarray], np.ndarray] | None = None,
     period: float | None = None,
     ghosts: Callable[[np.ndarray], np.ndarray] | None = None,
+    clamp: Callable[[np.ndarray], np.ndarray] | None = None,
     descent_steps: int = 300,
     max_edits: int = 80,
 ) -> Repaired:
@@ -292,6 +296,9 @@ def repair(
         the sliding samples' edge (unfolded), computed from the sliding
         samples' positions; they block Delaunay triangles across the edge and
         are never moved nor judged.
+    clamp : callable, optional
+        ``(k, 2) -> (k, 2)``: applied to the free samples after every step,
+        to keep them on the face (a free sample must not cross its edge).
     descent_steps, max_edits : int
         Work limits.
 
@@ -336,6 +343,7 @@ def repair(
         float(h),
         period,
         ghosts,
+        clamp,
     )
     _descend(prob, descent_steps)
     nbad, energy, bad, worst = _status(prob)
