@@ -32,7 +32,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
-LIMIT = float(np.sqrt(3.0) / 2.0)
 TARGET = 0.78  # the descent pushes every ratio below this
 BAD = 0.83  # a triangle above this still needs work (margin below sqrt(3)/2)
 SHORT = 0.6  # edges shorter than this (times h) are penalised
