@@ -1,4 +1,4 @@
-"""Local repair of Condition III-ii on a flat (or unrolled) face.
+"""Local repair of Condition III-ii on a planar face.
 
 Scan rows make a rectangular lattice, whose Delaunay triangles are right
 triangles (ratio 1/√2 of Condition III-ii), except where the rows meet a
@@ -19,9 +19,8 @@ Delaunay triangle meets the condition with a margin:
   sample is added at its centroid, whichever helps most after a short local
   descent (candidates in a fixed order, so the result is deterministic).
 
-The domain is 2-D: a planar face in plane coordinates, a cylinder unrolled
-(periodic in its first coordinate).  Everything is plain numpy and scipy's
-Delaunay; no randomness.
+The domain is 2-D (a planar face in plane coordinates).  Everything is
+plain numpy and scipy's Delaunay; no randomness.
 """
 
 from __future__ import annotations
@@ -64,9 +63,9 @@ class Repaired:
 
 
 class _Problem:
-    """Samples with their roles, ghost copies for a periodic domain."""
+    """Samples with their roles and the face's callbacks."""
 
-    def __init__(self, uv, free, slide, project, inside, h, period, ghosts=None, clamp=None):
+    def __init__(self, uv, free, slide, project, inside, h, ghosts=None, clamp=None):
         self.uv = np.asarray(uv, dtype=np.float64).copy()
         self.free = np.asarray(free, dtype=bool).copy()
         self.slide = np.asarray(slide, dtype=bool).copy()
@@ -74,7 +73,6 @@ class _Problem:
         self.project = project
         self.inside = inside
         self.h = h
-        self.period = period
         self.ghosts = ghosts
         self.clamp = clamp
 
@@ -100,28 +98,15 @@ class _Problem:
         return c
 
     def extended(self, subset=None):
-        """Points (with ghosts across the period) and the sample each stands for."""
+        """Points (with the ghosts, standing for sample -1) and the sample each is."""
         idx = np.arange(self.uv.shape[0]) if subset is None else subset
         pts = self.uv[idx]
         of = idx
-        if self.period is not None:
-            band = 4.0 * self.h
-            lo = pts[:, 0] < band
-            hi = pts[:, 0] > self.period - band
-            shift = np.array([self.period, 0.0])
-            pts = np.vstack([pts, pts[lo] + shift, pts[hi] - shift])
-            of = np.concatenate([of, of[lo], of[hi]])
         if self.ghosts is not None:
             g = self.ghosts(self.uv[idx[self.slide[idx]]])
             pts = np.vstack([pts, g])
             of = np.concatenate([of, np.full(g.shape[0], -1)])
         return pts, of
-
-    def keep_triangle(self, centroids):
-        ok = self.inside(centroids)
-        if self.period is not None:
-            ok &= (centroids[:, 0] >= 0.0) & (centroids[:, 0] < self.period)
-        return ok
 
 
 def _triangles(prob: _Problem, subset=None):
@@ -132,7 +117,7 @@ def _triangles(prob: _Problem, subset=None):
         tri = Delaunay(pts).simplices
     except QhullError:
         return pts, of, np.empty((0, 3), dtype=np.int64)
-    tri = tri[prob.keep_triangle(pts[tri].mean(axis=1))]
+    tri = tri[prob.inside(pts[tri].mean(axis=1))]
     return pts, of, tri
 
 
@@ -233,8 +218,6 @@ def _descend(prob: _Problem, steps: int, subset=None, active=None) -> None:
             prob.uv[prob.slide] = prob.project(prob.uv[prob.slide])
         if prob.clamp is not None and prob.free.any():
             prob.uv[prob.free] = prob.clamp(prob.uv[prob.free])
-        if prob.period is not None:
-            prob.uv[:, 0] %= prob.period
 
 
 def _status(prob: _Problem, subset=None, active=None):
@@ -244,11 +227,8 @@ def _status(prob: _Problem, subset=None, active=None):
 
 
 def _local(prob: _Problem, centre: np.ndarray, radius: float):
-    """Samples within ``radius`` of ``centre`` (periodic distance) and those that may move."""
-    d = prob.uv - centre
-    if prob.period is not None:
-        d[:, 0] = (d[:, 0] + prob.period / 2) % prob.period - prob.period / 2
-    r = np.linalg.norm(d, axis=1)
+    """Samples within ``radius`` of ``centre`` and those whose triangles are judged."""
+    r = np.linalg.norm(prob.uv - centre, axis=1)
     subset = np.flatnonzero(r < radius)
     active = np.zeros(prob.uv.shape[0], dtype=bool)
     active[r < radius - 1.5 * prob.h] = True
@@ -263,7 +243,6 @@ def repair(
     slide=None,
     project: Callable[[np.ndarray], np.ndarray] | None = None,
     inside: Callable[[np.ndarray], np.ndarray] | None = None,
-    period: float | None = None,
     ghosts: Callable[[np.ndarray], np.ndarray] | None = None,
     clamp: Callable[[np.ndarray], np.ndarray] | None = None,
     descent_steps: int = 300,
@@ -274,7 +253,7 @@ def repair(
     Parameters
     ----------
     uv : (n, 2) array_like of float
-        Samples in the face's (unrolled) coordinates.
+        Samples in the face's plane coordinates.
     free : (n,) array_like of bool
         Samples that may move anywhere in the plane (interior samples of the
         boundary layer).  Samples neither free nor sliding stay where they are.
@@ -288,8 +267,6 @@ def repair(
     inside : callable, optional
         ``(k, 2) -> (k,) bool``: whether a point is inside the face (Delaunay
         triangles whose centroid is outside are not the face's).
-    period : float, optional
-        Period of the first coordinate (an unrolled cylinder).
     ghosts : callable, optional
         ``(k, 2) -> (g, 2)``: points standing for the neighbouring face beyond
         the sliding samples' edge (unfolded), computed from the sliding
@@ -328,10 +305,6 @@ def repair(
     near = np.zeros(n, dtype=bool)
     for group in tree.query_ball_point(uv[movable], 3.0 * h):
         near[group] = True
-    if period is not None:
-        for shift in (period, -period):
-            for group in tree.query_ball_point(uv[movable] + (shift, 0.0), 3.0 * h):
-                near[group] = True
     sub = np.flatnonzero(near | movable)
     prob = _Problem(
         uv[sub],
@@ -340,7 +313,6 @@ def repair(
         project,
         inside if inside is not None else (lambda c: np.ones(c.shape[0], dtype=bool)),
         float(h),
-        period,
         ghosts,
         clamp,
     )
