@@ -2,19 +2,20 @@
 
 Straight scan rows end on a circle (a hole, a disk's rim, the cut of a
 spherical scoop) at arbitrary places, and the cells there break Condition
-III-ii.  This module repairs those layers face by face, in coordinates in
-which the face is flat and distances are the surface's own:
+III-ii.  This module mends that, face by face:
 
-* a **planar** face in plane coordinates (the two global axes other than
-  the normal's when the plane is axis-aligned, so that parallel faces of a
-  prism get the same answer and a hole's two rims line up);
-* a full **cylinder** unrolled to ``(R * angle, axial)``, periodic in the
-  angle, after its rims have moved with the planar faces they bound.
+* :func:`repair_planar_faces`: each planar face bounded by circular arcs,
+  in plane coordinates (the two global axes other than the normal's when
+  the plane is axis-aligned, so that parallel faces of a prism get the same
+  answer and a hole's two rims line up).  Samples on a sharp circular edge
+  slide along it, samples near it move freely, corners, straight-edge
+  samples and the rest of the lattice stay (:func:`samplers.repair.repair`);
+* :func:`lattice_cylinder_faces`: each full cylinder becomes the lattice its
+  two (now final) rims span;
+* :func:`lattice_cone_faces`: each full cone with a sampled rim becomes
+  rings that keep the rim's columns.
 
-Samples on a sharp circular edge slide along it, samples near it move
-freely, corners, straight-edge samples and the rest of the lattice stay
-(:func:`samplers.repair.repair`).  CadQuery and OCP are imported when the
-functions run.
+CadQuery and OCP are imported when the functions run.
 """
 
 from __future__ import annotations
@@ -96,7 +97,7 @@ def _boundary_segments(face, to2d, tol: float) -> np.ndarray:
 class _Arc:
     centre: np.ndarray  # 2-D
     radius: float
-    start: float  # angle range (radians) of the arc, None-like (0, 2 pi) when closed
+    start: float  # the arc runs from angle start to start + span (0, 2 pi when closed)
     span: float
     closed: bool
 
@@ -135,10 +136,14 @@ def _arcs(face, to2d) -> list[_Arc]:
     return out
 
 
+def _nearest_arc(arcs: list[_Arc], p: np.ndarray) -> np.ndarray:
+    """Index of the arc nearest to each point."""
+    return np.argmin(np.stack([a.distance(p) for a in arcs], axis=1), axis=1)
+
+
 def _project_onto(arcs: list[_Arc], margin: float):
     def project(p: np.ndarray) -> np.ndarray:
-        d = np.stack([a.distance(p) for a in arcs], axis=1)
-        which = np.argmin(d, axis=1)
+        which = _nearest_arc(arcs, p)
         out = p.copy()
         for k, a in enumerate(arcs):
             sel = which == k
@@ -149,20 +154,19 @@ def _project_onto(arcs: list[_Arc], margin: float):
     return project
 
 
-def _ghosts(arcs: list[_Arc], raster: _Raster, h: float):
+def _ghosts(arcs: list[_Arc], sides: list[float], h: float):
     """The neighbouring face unfolded across the arcs: rows h and 2h beyond each arc sample.
 
     The cylinder (or cone, or sphere) on the other side of a circular edge
     starts its lattice from the edge's samples, one row about h away from
-    the edge; unfolded into the plane those rows stand beyond the arc.
+    the edge; unfolded into the plane those rows stand beyond the arc
+    (``sides``: +1 where the face is inside the arc's circle, so outwards).
     """
-    sides = _arc_sides(arcs, raster, h)  # +1: face inside, unfold outwards
 
     def ghosts(p: np.ndarray) -> np.ndarray:
         if p.shape[0] == 0:
             return np.empty((0, 2))
-        d = np.stack([a.distance(p) for a in arcs], axis=1)
-        which = np.argmin(d, axis=1)
+        which = _nearest_arc(arcs, p)
         out = []
         for k, a in enumerate(arcs):
             q = p[which == k]
@@ -185,9 +189,8 @@ def _arc_sides(arcs: list[_Arc], raster: _Raster, h: float) -> list[float]:
     return sides
 
 
-def _clamp(arcs: list[_Arc], raster: _Raster, h: float):
+def _clamp(arcs: list[_Arc], sides: list[float], h: float):
     """Keep free samples on the face side of every arc, at least h / 4 from it."""
-    sides = _arc_sides(arcs, raster, h)
 
     def clamp(p: np.ndarray) -> np.ndarray:
         out = p.copy()
@@ -274,6 +277,7 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
             tuple((tuple(a.centre.round(12)), round(a.radius, 12), a.closed) for a in arcs),
         )
         if key not in done:
+            sides = _arc_sides(arcs, raster, h)
             done[key] = repair(
                 uv,
                 free,
@@ -281,12 +285,11 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
                 slide=slide,
                 project=_project_onto(arcs, 0.3 * h),
                 inside=raster,
-                ghosts=_ghosts(arcs, raster, h),
-                clamp=_clamp(arcs, raster, h),
+                ghosts=_ghosts(arcs, sides, h),
+                clamp=_clamp(arcs, sides, h),
             )
         r = done[key]
-        src_all = idx
-        src = np.where(r.origin >= 0, src_all[np.maximum(r.origin, 0)], -1)
+        src = np.where(r.origin >= 0, idx[np.maximum(r.origin, 0)], -1)
         moved = src >= 0
         pts3 = o + r.uv[:, :1] * u + r.uv[:, 1:] * v
         s.replace(
