@@ -150,6 +150,11 @@ def _exact_bounds(shape) -> tuple[np.ndarray, np.ndarray]:
     return np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
 
 
+def _dividing_step(extent: float, h: float) -> float:
+    """The spacing nearest ``h`` that divides ``extent`` into whole steps."""
+    return extent / max(1, round(extent / h)) if extent > 0 else h
+
+
 def _face_family(face, dirs: np.ndarray, tol: float) -> int:
     """The direction that cuts the face most transversally (area-weighted |n·d|)."""
     verts, tris = face.tessellate(tol, 0.3)
@@ -515,11 +520,8 @@ def scan(
         [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
     )
 
-    extent3 = hi - lo
-    # per coordinate axis: r times the spacing nearest h that divides the extent
-    axis_steps = ratio * np.array(
-        [e / max(1, round(e / h)) if e > 0 else h for e in extent3.tolist()]
-    )
+    # rows along a coordinate axis: r times that axis's plane spacing
+    axis_steps = ratio * np.array([_dividing_step(float(e), h) for e in hi - lo])
     pts, fids, feature_curve = _feature_samples(occ, EDGE_STEP * h, sharp_degrees, tol)
     n_feature = len(pts)
     line_ids = [-1] * n_feature
@@ -529,8 +531,7 @@ def scan(
         t0 = float((corner @ d).min())
         # the family's spacing divides the shape's extent along d, so the
         # last plane meets the far side as the first meets the near side
-        extent = float((corner @ d).max()) - t0
-        hf = extent / max(1, round(extent / h)) if extent > 0 else h
+        hf = _dividing_step(float((corner @ d).max()) - t0, h)
         flo, fhi = _exact_bounds(face)
         fc = np.array(
             [
