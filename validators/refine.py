@@ -213,7 +213,6 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
         _, near = cKDTree(v).query(pts[pending], kk)
         near = near.reshape(pending.size, kk)
         # candidate triangles: those around the kk nearest vertices (padded with -1)
-        inc = inc.tocsr()
         deg = np.diff(inc.indptr)
         width = int(deg[near].sum(axis=1).max())
         cand = np.full((pending.size, width), -1, dtype=np.int64)
@@ -237,9 +236,8 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
         best_tri = flat[at]
         best_bary = full_bary[at]
         edges, tedge = _unique_edges(t)
-        touched = np.zeros(t.shape[0], dtype=bool)
+        touched = np.zeros(t.shape[0], dtype=bool)  # split this round (replaced below)
         new_tris: list[list[int]] = []
-        drop = np.zeros(t.shape[0], dtype=bool)
         deferred = []
         # edge -> its (up to two) triangles
         owner = np.full((edges.shape[0], 2), -1, dtype=np.int64)
@@ -277,7 +275,6 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
             added.append(pts[i])
             index[i] = new_id
             touched[tris] = True
-            drop[tris] = True
             if not on_edge:
                 a, b, c = t[ti]
                 new_tris += [[a, b, new_id], [b, c, new_id], [c, a, new_id]]
@@ -291,7 +288,7 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
         if added:
             v = np.vstack([v, np.array(added)])
         if new_tris:
-            t = np.vstack([t[~drop], np.array(new_tris, dtype=np.int64).reshape(-1, 3)])
+            t = np.vstack([t[~touched], np.array(new_tris, dtype=np.int64).reshape(-1, 3)])
         if len(deferred) == pending.size:
             raise ValueError("could not insert the samples into the truth mesh")
         pending = np.array(deferred, dtype=np.int64)
