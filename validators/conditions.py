@@ -4,14 +4,14 @@
 geodesics on a ground-truth mesh (refined, the samples inserted as its
 vertices: :mod:`validators.refine`); it is the check to trust.
 
-:func:`local_delaunay`, for samples without a truth, approximates the intrinsic Delaunay triangulation
-DT_M around each sample by the Delaunay triangulation of its k nearest
-samples projected onto their best-fit (PCA) tangent plane, and measures
-Condition III: the degree of each sample (III-i, at most 33) and, for every
-triangle at the sample, the ratio of its second-longest to its longest edge
-(III-ii: below √3/2, the two shorter edges both shorter than √3/2 of the
-longest).  Near a sharp edge the projection flattens a fold, so the figures
-there are an approximation.
+:func:`local_delaunay`, for samples without a truth, approximates the
+intrinsic Delaunay triangulation DT_M around each sample by the Delaunay
+triangulation of its k nearest samples projected onto their best-fit (PCA)
+tangent plane, and measures Condition III: the degree of each sample
+(III-i, at most 33) and, for every triangle at the sample, the ratio of its
+second-longest to its longest edge (III-ii: below √3/2, the two shorter
+edges both shorter than √3/2 of the longest).  Near a sharp edge the
+projection flattens a fold, so the figures there are an approximation.
 """
 
 from __future__ import annotations
