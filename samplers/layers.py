@@ -30,6 +30,7 @@ from .repair import repair
 
 LAYER = 2.5  # samples within this many h of a circular edge may move
 RASTER = 8  # inside tests on a grid of h / RASTER
+LINE_EDITS = 0  # edits on a face with slanted straight edges only
 
 
 @dataclass
@@ -224,16 +225,126 @@ def _plane_frame(face):
     return o, u, v, n
 
 
-def repair_planar_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
-    """Repair the boundary layer of every planar face bounded by circular arcs.
+@dataclass(frozen=True)
+class _Line:
+    """A straight sharp edge of a planar face, slanted to the face's rows."""
+
+    a: np.ndarray  # 2-D ends
+    b: np.ndarray
+    inward: np.ndarray  # 2-D unit normal pointing into the face
+    frame: np.ndarray  # the neighbouring face's samples near the edge, unfolded (2-D)
+
+    def distance(self, p: np.ndarray) -> np.ndarray:
+        d = self.b - self.a
+        t = np.clip((p - self.a) @ d / (d @ d), 0.0, 1.0)
+        return np.linalg.norm(p - (self.a + t[:, None] * d), axis=1)
+
+
+def _neighbours(occ) -> list[list[tuple[object, int]]]:
+    """Per face, its edges and the index of the face on the other side (-1: none)."""
+    faces = occ.Faces()
+    edges = [f.Edges() for f in faces]
+    out = []
+    for fi, mine in enumerate(edges):
+        row = []
+        for e in mine:
+            other = -1
+            for fj, theirs in enumerate(edges):
+                if fj != fi and any(e.isSame(x) for x in theirs):
+                    other = fj
+                    break
+            row.append((e, other))
+        out.append(row)
+    return out
+
+
+def _slanted_lines(occ, fi, face, to2d, row_dir, s: Samples, raster, h, nbrs) -> list[_Line]:
+    """Sharp straight edges of a planar face, between it and another planar
+    face, neither parallel nor perpendicular to the face's scan rows (those
+    rows end on them at arbitrary places); with the other face's samples
+    within ``LAYER`` h of the edge unfolded into this face's plane (exact for
+    a polyhedral edge: geodesics across it unfold to straight lines)."""
+    n = np.array(face.normalAt().toTuple())
+    rows = np.cross(n, row_dir)
+    if np.linalg.norm(rows) < 1e-9:
+        return []
+    rows /= np.linalg.norm(rows)
+    faces = occ.Faces()
+    out = []
+    for e, fb in nbrs[fi]:
+        if e.geomType() != "LINE" or fb < 0 or faces[fb].geomType() != "PLANE":
+            continue
+        a3 = np.array(e.startPoint().toTuple())
+        b3 = np.array(e.endPoint().toTuple())
+        length = float(np.linalg.norm(b3 - a3))
+        u = (b3 - a3) / length
+        c = abs(float(u @ rows))
+        if c < 1e-6 or c > 1 - 1e-6:
+            continue
+        a2, b2 = to2d(np.stack([a3, b3]))
+        d2 = (b2 - a2) / np.linalg.norm(b2 - a2)
+        m = np.array([-d2[1], d2[0]])
+        if not raster(((a2 + b2) / 2 + 0.5 * h * m)[None])[0]:
+            m = -m
+        # inward normal of the edge in 3-D, in this face's plane
+        m3 = np.cross(n, u)
+        if (to2d((a3 + m3 * h)[None])[0] - a2) @ m < 0:
+            m3 = -m3
+        sel = np.flatnonzero((s.face_id == fb) & ~s.on_feature)
+        q = s.points[sel]
+        t = (q - a3) @ u
+        foot = a3 + t[:, None] * u
+        dist = np.linalg.norm(q - foot, axis=1)
+        near = (t > 0) & (t < length) & (dist < LAYER * h)
+        unfolded = foot[near] - dist[near, None] * m3
+        out.append(_Line(a2, b2, m, to2d(unfolded) if near.any() else np.empty((0, 2))))
+    return out
+
+
+def _chain(fns):
+    """The composition of the callables (in order)."""
+
+    def run(p: np.ndarray) -> np.ndarray:
+        for f in fns:
+            p = f(p)
+        return p
+
+    return run
+
+
+def _clamp_lines(lines: list[_Line], h: float):
+    """Keep free samples at least 0.4 h inside every slanted edge."""
+
+    def clamp(p: np.ndarray) -> np.ndarray:
+        out = p.copy()
+        for ln in lines:
+            d = ln.b - ln.a
+            t = (out - ln.a) @ d / (d @ d)
+            inward = (out - ln.a) @ ln.inward
+            bad = (t > 0) & (t < 1) & (inward < 0.4 * h) & (inward > -2 * h)
+            if bad.any():
+                out[bad] += (0.4 * h - inward[bad])[:, None] * ln.inward
+        return out
+
+    return clamp
+
+
+def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -> list[dict]:
+    """Repair the boundary layer of every planar face bounded by circular arcs
+    or by straight sharp edges slanted to its scan rows.
 
     The arcs' samples slide along them (the cylinders they bound are laid
-    out from them afterwards, :func:`lattice_cylinder_faces`); corners stay.
-    Returns one report per repaired face.
+    out from them afterwards, :func:`lattice_cylinder_faces`); corners and
+    samples on straight edges stay.  ``row_dirs`` (per face, the normal of
+    its scan planes) tells which straight edges are slanted; without it only
+    arcs are repaired.  Faces are taken in order, each seeing the samples of
+    the ones before it as they were left.  Returns one report per repaired
+    face.
     """
     reports = []
     done: dict[tuple, object] = {}
     tol = 1e-7 * size
+    nbrs = _neighbours(occ) if row_dirs is not None else None
     for fi, face in enumerate(occ.Faces()):
         if face.geomType() != "PLANE":
             continue
@@ -244,11 +355,18 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
             return np.stack([q @ u, q @ v], axis=1)
 
         arcs = _arcs(face, to2d)
-        if not arcs:
+        if not arcs and row_dirs is None:
             continue
-        on_plane = np.abs((s.points - o) @ n) < tol
         seg = _boundary_segments(face, to2d, h / 20)
         raster = _Raster(seg, h / RASTER)
+        lines = (
+            _slanted_lines(occ, fi, face, to2d, np.asarray(row_dirs[fi]), s, raster, h, nbrs)
+            if row_dirs is not None
+            else []
+        )
+        if not arcs and not lines:
+            continue
+        on_plane = np.abs((s.points - o) @ n) < tol
         cand = np.flatnonzero(on_plane)
         uv = to2d(s.points[cand])
         # the face's samples: inside it, or on its boundary (the tessellation's
@@ -259,34 +377,43 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         # a fixed order (by position) so that congruent faces get the same answer
         order = np.lexsort((np.round(uv[:, 1] / h, 6), np.round(uv[:, 0] / h, 6)))
         idx, uv = idx[order], uv[order]
-        near_arc = np.min(np.stack([a.distance(uv) for a in arcs], axis=1), axis=1)
+        far = np.full(uv.shape[0], np.inf)
+        near_arc = np.min(np.stack([far] + [a.distance(uv) for a in arcs], axis=1), axis=1)
+        near_line = np.min(np.stack([far] + [ln.distance(uv) for ln in lines], axis=1), axis=1)
         corners = _corner_points(face, to2d)
         at_corner = (
             cKDTree(corners).query(uv)[0] < tol if corners.shape[0] else np.zeros(len(uv), bool)
         )
         feat = s.on_feature[idx]
         slide = feat & (near_arc < tol) & ~at_corner
-        free = ~feat & (near_arc < LAYER * h)
+        free = ~feat & ((near_arc < LAYER * h) | (near_line < LAYER * h))
         if not (free.any() or slide.any()):
             continue
+        frame = np.vstack([np.empty((0, 2))] + [ln.frame for ln in lines])
         # congruent faces (a prism's two ends) get one answer: their rims must agree
         key = (
             uv.round(12).tobytes(),
             slide.tobytes(),
             free.tobytes(),
             tuple((tuple(a.centre.round(12)), round(a.radius, 12), a.closed) for a in arcs),
+            frame.round(12).tobytes(),
         )
         if key not in done:
             sides = _arc_sides(arcs, raster, h)
+            clamps = ([_clamp(arcs, sides, h)] if arcs else []) + (
+                [_clamp_lines(lines, h)] if lines else []
+            )
             done[key] = repair(
                 uv,
                 free,
                 h,
                 slide=slide,
-                project=_project_onto(arcs, 0.3 * h),
+                project=_project_onto(arcs, 0.3 * h) if arcs else None,
                 inside=raster,
-                ghosts=_ghosts(arcs, sides, h),
-                clamp=_clamp(arcs, sides, h),
+                ghosts=_ghosts(arcs, sides, h) if arcs else None,
+                clamp=_chain(clamps),
+                frame=frame,
+                max_edits=None if arcs else LINE_EDITS,
             )
         r = done[key]
         src = np.where(r.origin >= 0, idx[np.maximum(r.origin, 0)], -1)

@@ -17,7 +17,8 @@ Delaunay triangle meets the condition with a margin:
   and samples far from the layer stay fixed;
 * where the descent is stuck, one sample of a bad triangle is removed or a
   sample is added at its centroid, whichever helps most after a short local
-  descent (candidates in a fixed order, so the result is deterministic).
+  descent (candidates in a fixed order, so the result is deterministic);
+  bad triangles far apart (``SEPARATION``) are edited in the same round.
 
 The domain is 2-D (a planar face in plane coordinates).  Everything is
 plain numpy and scipy's Delaunay; no randomness.
@@ -37,6 +38,8 @@ SHORT = 0.6  # edges shorter than this (times h) are penalised
 WIDE = 1.0  # circumradii larger than this (times h) are penalised
 GAP = (0.75, 1.35)  # spacing kept between neighbours sliding along one edge, times h
 STEP = 0.02  # largest move per descent step, times h
+SEPARATION = 12.0  # bad triangles edited at once are this far apart, times h
+REACH = 4.0  # in a local descent, triangles with a longer edge (times h) join two regions
 _EDGES = np.array([[0, 1], [1, 2], [2, 0]])
 
 
@@ -65,7 +68,7 @@ class Repaired:
 class _Problem:
     """Samples with their roles and the face's callbacks."""
 
-    def __init__(self, uv, free, slide, project, inside, h, ghosts=None, clamp=None):
+    def __init__(self, uv, free, slide, project, inside, h, ghosts=None, clamp=None, frame=None):
         self.uv = np.asarray(uv, dtype=np.float64).copy()
         self.free = np.asarray(free, dtype=bool).copy()
         self.slide = np.asarray(slide, dtype=bool).copy()
@@ -75,10 +78,24 @@ class _Problem:
         self.h = h
         self.ghosts = ghosts
         self.clamp = clamp
+        self.frame = np.empty((0, 2)) if frame is None else np.asarray(frame, dtype=np.float64)
+        self._watch: np.ndarray | None = None
 
     def watch(self) -> np.ndarray:
         """Samples whose triangles are judged: the movable ones and fixed ones
-        within 1.5 h of them (a removal may open a bad triangle among those)."""
+        within 1.5 h of them (a removal may open a bad triangle among those).
+
+        Kept until :meth:`forget` (each descent starts by forgetting): within
+        one descent the samples move a few hundredths of h.
+        """
+        if self._watch is None:
+            self._watch = self._compute_watch()
+        return self._watch
+
+    def forget(self) -> None:
+        self._watch = None
+
+    def _compute_watch(self) -> np.ndarray:
         move = self.free | self.slide
         out = move.copy()
         if move.any() and (~move).any():
@@ -95,6 +112,7 @@ class _Problem:
             self.slide.copy(),
             self.origin.copy(),
         )
+        c._watch = None
         return c
 
     def extended(self, subset=None):
@@ -106,6 +124,12 @@ class _Problem:
             g = self.ghosts(self.uv[idx[self.slide[idx]]])
             pts = np.vstack([pts, g])
             of = np.concatenate([of, np.full(g.shape[0], -1)])
+        if self.frame.shape[0] and idx.size:
+            lo = self.uv[idx].min(axis=0) - 3 * self.h
+            hi = self.uv[idx].max(axis=0) + 3 * self.h
+            f = self.frame[((self.frame >= lo) & (self.frame <= hi)).all(axis=1)]
+            pts = np.vstack([pts, f])
+            of = np.concatenate([of, np.full(f.shape[0], -1)])
         return pts, of
 
 
@@ -132,11 +156,14 @@ def _energy(prob: _Problem, subset=None, active=None):
     watch = prob.watch()
     active = watch if active is None else active & watch
     tri = tri[active[of[tri]].any(axis=1)]
-    if tri.shape[0] == 0:
-        return 0.0, grad, np.empty(0), tri
     p = pts[tri]
     vec = p[:, _EDGES[:, 0]] - p[:, _EDGES[:, 1]]  # (m, 3, 2)
     length = np.linalg.norm(vec, axis=2)
+    if subset is not None:  # several regions at once: no triangle joins two
+        near = length.max(axis=1) <= REACH * h
+        tri, p, vec, length = tri[near], p[near], vec[near], length[near]
+    if tri.shape[0] == 0:
+        return 0.0, grad, np.empty(0), tri
     order = np.argsort(length, axis=1)
     rows = np.arange(tri.shape[0])
     i2, i3 = order[:, 1], order[:, 2]
@@ -195,8 +222,15 @@ def _energy(prob: _Problem, subset=None, active=None):
     return energy, grad, rho, of[tri]
 
 
-def _descend(prob: _Problem, steps: int, subset=None, active=None) -> None:
+def _descend(prob: _Problem, steps: int, subset=None, active=None, centres=None) -> None:
+    """Gradient steps; the largest move is ``STEP`` h, per region when ``centres``
+    are given (every sample belongs to its nearest centre), so that a region
+    far from the others moves at its own pace."""
     h = prob.h
+    prob.forget()
+    label = None
+    if centres is not None and len(centres) > 1:
+        _, label = cKDTree(np.asarray(centres)).query(prob.uv)
     best, since = np.inf, 0
     for _ in range(steps):
         energy, grad, rho, _ = _energy(prob, subset, active)
@@ -209,11 +243,17 @@ def _descend(prob: _Problem, steps: int, subset=None, active=None) -> None:
             since += 1
             if since >= 15:
                 return
-        g = np.linalg.norm(grad, axis=1).max()
-        if g == 0.0:
+        norm = np.linalg.norm(grad, axis=1)
+        if label is None:
+            g = np.full(norm.size, norm.max())
+        else:
+            peak = np.zeros(len(centres))
+            np.maximum.at(peak, label, norm)
+            g = peak[label]
+        if not (g > 0.0).any():
             return
-        move = prob.free | prob.slide
-        prob.uv[move] -= (STEP * h / g) * grad[move]
+        move = (prob.free | prob.slide) & (g > 0.0)
+        prob.uv[move] -= (STEP * h / g[move])[:, None] * grad[move]
         if prob.slide.any():
             prob.uv[prob.slide] = prob.project(prob.uv[prob.slide])
         if prob.clamp is not None and prob.free.any():
@@ -221,6 +261,7 @@ def _descend(prob: _Problem, steps: int, subset=None, active=None) -> None:
 
 
 def _status(prob: _Problem, subset=None, active=None):
+    prob.forget()
     energy, _, rho, tri = _energy(prob, subset, active)
     bad = tri[rho > BAD] if rho.size else tri[:0]
     return int(bad.shape[0]), energy, bad, (float(rho.max()) if rho.size else 0.0)
@@ -245,8 +286,9 @@ def repair(
     inside: Callable[[np.ndarray], np.ndarray] | None = None,
     ghosts: Callable[[np.ndarray], np.ndarray] | None = None,
     clamp: Callable[[np.ndarray], np.ndarray] | None = None,
+    frame=None,
     descent_steps: int = 300,
-    max_edits: int = 80,
+    max_edits: int | None = None,
 ) -> Repaired:
     """Move, remove or add samples until Condition III-ii holds with a margin.
 
@@ -275,8 +317,13 @@ def repair(
     clamp : callable, optional
         ``(k, 2) -> (k, 2)``: applied to the free samples after every step,
         to keep them on the face (a free sample must not cross its edge).
+    frame : (g, 2) array_like of float, optional
+        Fixed points standing for a neighbouring face (unfolded across a
+        straight edge); like the ghosts they block Delaunay triangles across
+        the edge and are never moved nor judged.
     descent_steps, max_edits : int
-        Work limits.
+        Work limits (``max_edits`` defaults to an eighth of the movable
+        samples, at least 80).
 
     Returns
     -------
@@ -315,42 +362,35 @@ def repair(
         float(h),
         ghosts,
         clamp,
+        frame,
     )
     _descend(prob, descent_steps)
-    nbad, energy, bad, worst = _status(prob)
+    nbad, _, bad, worst = _status(prob)
+    if max_edits is None:
+        max_edits = max(80, int(movable.sum()) // 8)
     edits = 0
+    skip: set[tuple] = set()
+    cleared_at = 0
     while nbad and edits < max_edits:
-        best = None
-        tried: set[tuple] = set()
-        for tri in bad:
-            centre = prob.uv[tri].mean(axis=0)
-            region = _local(prob, centre, 5.0 * prob.h)
-            before = _status(prob, *region)
-            cands: list[tuple[str, object]] = [("del", int(v)) for v in tri if prob.free[v]]
-            cands.append(("add", centre))
-            for kind, arg in cands:
-                key = (kind, arg) if kind == "del" else (kind, tuple(np.round(arg, 12)))
-                if key in tried:
-                    continue
-                tried.add(key)
-                trial = _edited(prob, kind, arg)
-                subset, active = _local(trial, centre, 5.0 * prob.h)
-                _descend(trial, 40, subset, active)
-                after = _status(trial, subset, active)
-                gain = (before[0] - after[0], before[1] - after[1])
-                if gain[0] > 0 or (gain[0] == 0 and gain[1] > 1e-9):
-                    if best is None or gain > best[0]:
-                        best = (gain, trial, centre)
-            if best is not None and best[0][0] > 0:
+        regions = _regions(prob, bad, skip)
+        if not regions:
+            if edits == cleared_at:
                 break
-        if best is None:
-            break
-        prob = best[1]
-        edits += 1
-        # relax a wider neighbourhood of the edit (a global descent per edit
+            # edits since the stuck triangles were tried may have freed them
+            skip.clear()
+            cleared_at = edits
+            continue
+        chosen = _best_edits(prob, regions, skip)
+        if not chosen:
+            continue
+        chosen = chosen[: max_edits - edits]
+        prob = _edited(prob, [edit for edit, _ in chosen])
+        edits += len(chosen)
+        # relax a wider neighbourhood of every edit (a global descent per edit
         # would make the repair quadratic in the number of samples)
-        _descend(prob, 60, *_local(prob, best[2], 8.0 * prob.h))
-        nbad, energy, bad, worst = _status(prob)
+        centres = [c for _, c in chosen]
+        _descend(prob, 60, *_union(prob, centres, 8.0), centres=centres)
+        nbad, _, bad, worst = _status(prob)
     # put the frame back among the untouched samples
     rest = np.setdiff1d(np.arange(n), sub)
     origin = np.where(prob.origin >= 0, sub[np.maximum(prob.origin, 0)], -1)
@@ -362,20 +402,84 @@ def repair(
     )
 
 
-def _edited(prob: _Problem, kind: str, arg) -> _Problem:
+def _edited(prob: _Problem, edits) -> _Problem:
+    """A copy of the problem with samples removed (``("del", index)``) and added
+    (``("add", position)``): new samples are free and come last."""
     trial = prob.copy()
-    if kind == "del":
-        keep = np.ones(trial.uv.shape[0], dtype=bool)
-        keep[arg] = False
-        trial.uv, trial.free, trial.slide, trial.origin = (
-            trial.uv[keep],
-            trial.free[keep],
-            trial.slide[keep],
-            trial.origin[keep],
-        )
-    else:
-        trial.uv = np.vstack([trial.uv, np.asarray(arg, dtype=np.float64)[None]])
-        trial.free = np.r_[trial.free, True]
-        trial.slide = np.r_[trial.slide, False]
-        trial.origin = np.r_[trial.origin, -1]
+    keep = np.ones(trial.uv.shape[0], dtype=bool)
+    keep[[arg for kind, arg in edits if kind == "del"]] = False
+    add = [np.asarray(arg, dtype=np.float64) for kind, arg in edits if kind == "add"]
+    trial.uv = np.vstack([trial.uv[keep], *[a[None] for a in add]])
+    trial.free = np.r_[trial.free[keep], np.ones(len(add), dtype=bool)]
+    trial.slide = np.r_[trial.slide[keep], np.zeros(len(add), dtype=bool)]
+    trial.origin = np.r_[trial.origin[keep], np.full(len(add), -1)]
     return trial
+
+
+def _union(prob: _Problem, centres, radius: float):
+    """:func:`_local` for several centres at once (their subsets and active sets joined)."""
+    subset = np.zeros(prob.uv.shape[0], dtype=bool)
+    active = np.zeros(prob.uv.shape[0], dtype=bool)
+    for c in centres:
+        sub, act = _local(prob, c, radius * prob.h)
+        subset[sub] = True
+        active |= act
+    return np.flatnonzero(subset), active
+
+
+def _key(centre: np.ndarray) -> tuple:
+    return tuple(np.round(centre, 9).tolist())
+
+
+def _regions(prob: _Problem, bad: np.ndarray, skip: set) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Bad triangles to edit at once: in order of their centres (x, then y),
+    skipping those already found stuck, each at least ``SEPARATION`` h from
+    the ones taken before it, so that their edits do not interact."""
+    centres = prob.uv[bad].mean(axis=1)
+    order = np.lexsort((centres[:, 1], centres[:, 0]))
+    taken: list[int] = []
+    for i in order.tolist():
+        if _key(centres[i]) in skip:
+            continue
+        gap = np.linalg.norm(centres[taken] - centres[i], axis=1)
+        if gap.size and gap.min() < SEPARATION * prob.h:
+            continue
+        taken.append(i)
+    return [(bad[i], centres[i]) for i in taken]
+
+
+def _best_edits(prob: _Problem, regions, skip: set) -> list[tuple[tuple, np.ndarray]]:
+    """The edit that helps each region most, tried for all regions at once.
+
+    Candidates per bad triangle: remove one of its free samples (in the
+    triangle's order), or add a sample at its centroid.  Candidate j of every
+    region is applied in one trial, followed by a short descent around the
+    regions; a region's gain is (fewer bad triangles, lower energy) within
+    5 h of it.  Regions with no gain are added to ``skip``.
+    """
+    h = prob.h
+    cands = [
+        [("del", int(v)) for v in tri if prob.free[v]] + [("add", centre)]
+        for tri, centre in regions
+    ]
+    before = [_status(prob, *_local(prob, centre, 5.0 * h))[:2] for _, centre in regions]
+    best: list[tuple | None] = [None] * len(regions)
+    for j in range(max(len(c) for c in cands)):
+        which = [g for g in range(len(regions)) if j < len(cands[g])]
+        trial = _edited(prob, [cands[g][j] for g in which])
+        centres = [regions[g][1] for g in which]
+        _descend(trial, 40, *_union(trial, centres, 5.0), centres=centres)
+        for g in which:
+            after = _status(trial, *_local(trial, regions[g][1], 5.0 * h))
+            gain = (before[g][0] - after[0], before[g][1] - after[1])
+            if (gain[0] > 0 or (gain[0] == 0 and gain[1] > 1e-9)) and (
+                best[g] is None or gain > best[g][0]
+            ):
+                best[g] = (gain, cands[g][j])
+    out = []
+    for g, b in enumerate(best):
+        if b is None:
+            skip.add(_key(regions[g][1]))
+        else:
+            out.append((b[1], regions[g][1]))
+    return out

@@ -578,7 +578,7 @@ def scan(
         )
 
         bag = Samples(points, line_id, face_id, on_feature)
-        reports = repair_planar_faces(occ, bag, h, size)
+        reports = repair_planar_faces(occ, bag, h, size, row_dirs=[dirs[f] for f in fam])
         reports += lattice_cylinder_faces(occ, bag, h, size)
         reports += lattice_cone_faces(occ, bag, h, size)
         points, line_id, face_id, on_feature = (
