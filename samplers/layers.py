@@ -30,6 +30,9 @@ from .repair import repair
 
 LAYER = 2.5  # samples within this many h of a circular edge may move
 RASTER = 8  # inside tests on a grid of h / RASTER
+END_GAP = 0.8  # a ring's column ends where its gap falls below this (times the row step)
+END_MERGED = 1.65  # ... unless the merged gap would exceed this
+NARROW = 0.6  # ... or it ends anyway once a gap is below this (times the row step)
 LINE_EDITS = 0  # edits on a face with slanted straight edges only
 
 
@@ -440,6 +443,13 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -
     return reports
 
 
+def _full_turns_of(face):
+    """The face itself when it goes all the way round its axis."""
+    umin, umax, _, _ = face._uvBounds()
+    if abs((umax - umin) - 2 * math.pi) <= 1e-9:
+        yield face
+
+
 def _full_turns(occ, kind: str):
     """(index, face) of the faces of a surface type that go all the way round
     (a partial cylinder is a fillet: its smooth edges are not sampled)."""
@@ -594,18 +604,131 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
 
 
 def _end_columns(ang: np.ndarray, scale: float, t: float) -> np.ndarray:
-    """Columns (angles) left on a row of radius ``scale`` after ending the crowded ones."""
-    ang = ang.copy()
-    while ang.size > 3:
-        gap = np.diff(np.r_[ang, ang[0] + 2 * math.pi]) * scale  # gap k: column k to k + 1
-        k = int(np.argmin(gap))
-        if gap[k] >= 0.75 * t:
-            break
-        m = ang.size
-        merged_k = gap[k - 1] + gap[k]  # ending column k
-        merged_k1 = gap[k] + gap[(k + 1) % m]  # ending column k + 1
-        end = k if merged_k <= merged_k1 else (k + 1) % m
-        if min(merged_k, merged_k1) > 1.6 * t and gap[k] >= 0.5 * t:
-            break  # ending one would leave too wide a cell; keep both while they are apart
-        ang = np.delete(ang, end)
-    return ang
+    """Columns (angles) left on a row of radius ``scale`` after ending the crowded ones.
+
+    One walk round the row, starting at the column after the widest gap
+    (the first on ties), which stays: a column ends when the gap from the
+    last column kept to it is below ``END_GAP`` t and the merged gap to
+    the next column stays within ``END_MERGED`` t, or when that gap is
+    below ``NARROW`` t whatever the merged gap.  On a ring of equal gaps
+    every other column ends.
+    """
+    m = ang.size
+    if m <= 3:
+        return ang.copy()
+    gap = np.diff(np.r_[ang, ang[0] + 2 * math.pi]) * scale  # gap k: column k to k + 1
+    start = (int(np.argmax(gap)) + 1) % m
+    order = (start + np.arange(m)) % m
+    keep = np.ones(m, dtype=bool)
+    since = 0.0  # from the last column kept to the current one
+    for i in range(1, m):
+        k = order[i]
+        since += gap[order[i - 1]]
+        merged = since + gap[k]
+        if keep.sum() > 3 and (
+            (since < END_GAP * t and merged <= END_MERGED * t) or since < NARROW * t
+        ):
+            keep[k] = False
+        else:
+            since = 0.0
+    return ang[keep]
+
+
+def _revolution_axis(face):
+    """(point, unit direction) of a cone's or sphere's axis."""
+    g = face._geomAdaptor()
+    pos = (g.Cone() if face.geomType() == "CONE" else g.Sphere()).Position()
+    return np.array(pos.Location().Coord()), np.array(pos.Direction().Coord())
+
+
+def _meridian(face, o, axis, count: int = 2000):
+    """The face's meridian at u = umin: parameters v and (axial, radial) coordinates."""
+    umin, _, vmin, vmax = face._uvBounds()
+    g = face._geomAdaptor()
+    v = np.linspace(vmin, vmax, count)
+    p = np.array([g.Value(umin, x).Coord() for x in v]) - o
+    z = p @ axis
+    rho = np.linalg.norm(p - z[:, None] * axis, axis=1)
+    return v, z, rho
+
+
+def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
+    """Lay a closed body of revolution out in rings that keep their columns.
+
+    Applies when every face is a full cone or sphere about one axis and the
+    faces meet along smooth circles (the revolved cone tip): the meridian
+    from pole to pole is cut into ``round(S / h)`` equal arc-length steps,
+    every step a ring (a parallel); the widest ring gets evenly spaced
+    columns about h apart, and the rings towards either pole keep the
+    columns of the ring before them, ending crowded ones as on a cone
+    (:func:`lattice_cone_faces`).  Samples on the axis (the apex, the
+    poles) stay; every other sample of the body is replaced (the seam's
+    vertices are not features of the surface).  Each ring sample is the
+    exact meridian point turned about the axis, so it lies on the surface.
+    """
+    faces = occ.Faces()
+    if not faces or any(f.geomType() not in ("CONE", "SPHERE") for f in faces):
+        return []
+    if not all(any(True for _ in _full_turns_of(f)) for f in faces):
+        return []
+    tol = 1e-7 * size
+    o, axis = _revolution_axis(faces[0])
+    for f in faces[1:]:
+        p, d = _revolution_axis(f)
+        off = p - o
+        if abs(abs(d @ axis) - 1) > 1e-9 or np.linalg.norm(off - (off @ axis) * axis) > tol:
+            return []
+    off_axis = np.linalg.norm(np.cross(s.points - o, axis), axis=1) > tol
+    if (s.on_feature & off_axis).sum() > len(occ.Vertices()):
+        return []  # a sampled edge off the axis: not a smooth body
+    # the meridian, face after face, from the lowest point along the axis
+    parts = [(fi, *_meridian(f, o, axis)) for fi, f in enumerate(faces)]
+    for k, (fi, v, z, rho) in enumerate(parts):
+        if z[0] > z[-1]:
+            parts[k] = (fi, v[::-1], z[::-1], rho[::-1])
+    parts.sort(key=lambda q: q[2][0])
+    seg = [np.r_[0.0, np.cumsum(np.hypot(np.diff(q[2]), np.diff(q[3])))] for q in parts]
+    starts = np.cumsum([0.0] + [x[-1] for x in seg[:-1]])
+    total = float(starts[-1] + seg[-1][-1])
+    rows = max(2, round(total / h))
+    t = total / rows
+    umin = [f._uvBounds()[0] for f in faces]
+    ring = []  # (face, axial, radial) per row 1 .. rows - 1
+    for j in range(1, rows):
+        sj = j * t
+        k = int(np.searchsorted(starts, sj, side="right") - 1)
+        fi, v, _, _ = parts[k]
+        vj = float(np.interp(sj - starts[k], seg[k], v))
+        p = np.array(faces[fi]._geomAdaptor().Value(umin[fi], vj).Coord()) - o
+        z = float(p @ axis)
+        ring.append((fi, z, float(np.linalg.norm(p - z * axis))))
+    radial = np.array([r for _, _, r in ring])
+    widest = int(np.argmax(radial))
+    ex = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
+    ex /= np.linalg.norm(ex)
+    ey = np.cross(axis, ex)
+    m = max(3, round(2 * math.pi * radial[widest] / h))
+    columns = {widest: 2 * math.pi * np.arange(m) / m}
+    for step in (-1, 1):
+        ang = columns[widest]
+        j = widest + step
+        while 0 <= j < len(ring):
+            ang = _end_columns(ang, radial[j], t)
+            columns[j] = ang
+            j += step
+    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
+    pts, ids, fids = [], [], []
+    for j, (fi, z, r) in enumerate(ring):
+        ang = columns[j]
+        pts.append(o + z * axis + r * (np.cos(ang)[:, None] * ex + np.sin(ang)[:, None] * ey))
+        ids.append(np.full(ang.size, line + j))
+        fids.append(np.full(ang.size, fi))
+    new = np.vstack(pts)
+    s.replace(
+        np.flatnonzero(off_axis),  # all but the apex and poles (seam vertices too)
+        new,
+        np.concatenate(ids),
+        np.concatenate(fids),
+        np.zeros(new.shape[0], dtype=bool),
+    )
+    return [{"kind": "revolved rings", "rows": len(ring), "columns": m, "samples": len(new)}]

@@ -574,6 +574,7 @@ def scan(
             Samples,
             lattice_cone_faces,
             lattice_cylinder_faces,
+            lattice_revolved_body,
             repair_planar_faces,
         )
 
@@ -581,6 +582,7 @@ def scan(
         reports = repair_planar_faces(occ, bag, h, size, row_dirs=[dirs[f] for f in fam])
         reports += lattice_cylinder_faces(occ, bag, h, size)
         reports += lattice_cone_faces(occ, bag, h, size)
+        reports += lattice_revolved_body(occ, bag, h, size)
         points, line_id, face_id, on_feature = (
             bag.points,
             bag.line_id,

@@ -104,3 +104,25 @@ def test_repairs_are_reported_and_congruent_ends_agree(sampled):
         return q[np.lexsort(q.T[::-1])]
 
     np.testing.assert_allclose(rim(0.25), rim(-0.25), atol=1e-12)
+
+
+def test_revolved_body_is_laid_out_in_rings():
+    """cone_tip (a cone and a ball meeting smoothly): one ring per meridian step,
+    the columns of a ring a subset of the widest ring's, on the surface."""
+    import math
+
+    s = shapes.build("cone_tip")
+    r = scan(s)
+    (rep,) = [x for x in r.meta["repairs"] if x["kind"] == "revolved rings"]
+    off = np.hypot(r.points[:, 0], r.points[:, 1]) > 1e-9
+    assert int(off.sum()) == rep["samples"]
+    z = np.round(r.points[off, 2], 9)
+    assert np.unique(z).size == rep["rows"]
+    ang = np.arctan2(r.points[off, 1], r.points[off, 0]) % (2 * math.pi)
+    step = 2 * math.pi / rep["columns"]
+    k = ang / step - ang[0] / step
+    assert np.abs(k - np.round(k)).max() < 1e-6  # every column is one of the widest ring's
+    from validators.fidelity import distance_to_surface
+
+    d = distance_to_surface(r.points, s.truth_vertices, s.truth_triangles)
+    assert d.max() < 2e-3 * r.meta["spacing"] * 50  # on the surface, up to the truth's sagitta
