@@ -443,21 +443,17 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -
     return reports
 
 
-def _full_turns_of(face):
-    """The face itself when it goes all the way round its axis."""
+def _goes_round(face) -> bool:
+    """Whether a face of revolution goes all the way round its axis."""
     umin, umax, _, _ = face._uvBounds()
-    if abs((umax - umin) - 2 * math.pi) <= 1e-9:
-        yield face
+    return abs((umax - umin) - 2 * math.pi) <= 1e-9
 
 
 def _full_turns(occ, kind: str):
     """(index, face) of the faces of a surface type that go all the way round
     (a partial cylinder is a fillet: its smooth edges are not sampled)."""
     for fi, face in enumerate(occ.Faces()):
-        if face.geomType() != kind:
-            continue
-        umin, umax, _, _ = face._uvBounds()
-        if abs((umax - umin) - 2 * math.pi) <= 1e-9:
+        if face.geomType() == kind and _goes_round(face):
             yield fi, face
 
 
@@ -669,7 +665,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     faces = occ.Faces()
     if not faces or any(f.geomType() not in ("CONE", "SPHERE") for f in faces):
         return []
-    if not all(any(True for _ in _full_turns_of(f)) for f in faces):
+    if not all(_goes_round(f) for f in faces):
         return []
     tol = 1e-7 * size
     o, axis = _revolution_axis(faces[0])
