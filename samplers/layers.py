@@ -600,29 +600,6 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
 
 
 def _end_columns(ang: np.ndarray, scale: float, t: float) -> np.ndarray:
-    """Columns left on a row of a cone with a sampled rim: the closest pair
-    loses one column at a time while a gap is below 0.75 t and the merged
-    gap stays within 1.6 t (or the gap is below 0.5 t).  The walk of
-    :func:`_end_columns_walk` gives fewer Condition III violations on the
-    cone (5.1% against 7.2%) but its reconstruction opens (200 open edges
-    at k = 33), so cones keep this rule."""
-    ang = ang.copy()
-    while ang.size > 3:
-        gap = np.diff(np.r_[ang, ang[0] + 2 * math.pi]) * scale  # gap k: column k to k + 1
-        k = int(np.argmin(gap))
-        if gap[k] >= 0.75 * t:
-            break
-        m = ang.size
-        merged_k = gap[k - 1] + gap[k]  # ending column k
-        merged_k1 = gap[k] + gap[(k + 1) % m]  # ending column k + 1
-        end = k if merged_k <= merged_k1 else (k + 1) % m
-        if min(merged_k, merged_k1) > 1.6 * t and gap[k] >= 0.5 * t:
-            break  # ending one would leave too wide a cell; keep both while they are apart
-        ang = np.delete(ang, end)
-    return ang
-
-
-def _end_columns_walk(ang: np.ndarray, scale: float, t: float) -> np.ndarray:
     """Columns (angles) left on a row of radius ``scale`` after ending the crowded ones.
 
     One walk round the row, starting at the column after the widest gap
@@ -680,7 +657,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     every step a ring (a parallel); the widest ring gets evenly spaced
     columns about h apart, and the rings towards either pole keep the
     columns of the ring before them, ending crowded ones as on a cone
-    (:func:`_end_columns_walk`).  Samples on the axis (the apex, the
+    (:func:`lattice_cone_faces`).  Samples on the axis (the apex, the
     poles) stay; every other sample of the body is replaced (the seam's
     vertices are not features of the surface).  Each ring sample is the
     exact meridian point turned about the axis, so it lies on the surface.
@@ -732,7 +709,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         ang = columns[widest]
         j = widest + step
         while 0 <= j < len(ring):
-            ang = _end_columns_walk(ang, radial[j], t)
+            ang = _end_columns(ang, radial[j], t)
             columns[j] = ang
             j += step
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0

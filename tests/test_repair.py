@@ -82,11 +82,11 @@ def test_nothing_to_move_returns_the_input():
 def test_ring_of_equal_gaps_ends_every_other_column():
     import math
 
-    from samplers.layers import _end_columns_walk
+    from samplers.layers import _end_columns
 
     ang = 2 * math.pi * np.arange(40) / 40
     scale = 0.76 * 40 / (2 * math.pi)  # gaps of 0.76 t: below END_GAP
-    out = _end_columns_walk(ang, scale, 1.0)
+    out = _end_columns(ang, scale, 1.0)
     np.testing.assert_array_equal(out, ang[1::2])  # after the widest gap (the first, on ties)
     wide = 1.2 * 40 / (2 * math.pi)  # gaps of 1.2 t: nothing ends
-    np.testing.assert_array_equal(_end_columns_walk(ang, wide, 1.0), ang)
+    np.testing.assert_array_equal(_end_columns(ang, wide, 1.0), ang)
