@@ -85,8 +85,9 @@ class _Problem:
         """Samples whose triangles are judged: the movable ones and fixed ones
         within 1.5 h of them (a removal may open a bad triangle among those).
 
-        Kept until :meth:`forget` (each descent starts by forgetting): within
-        one descent the samples move a few hundredths of h.
+        Kept until :meth:`forget`: a descent forgets it when it starts and
+        when it ends (within one descent the samples move a few hundredths
+        of h); an edited copy starts without it.
         """
         if self._watch is None:
             self._watch = self._compute_watch()
@@ -226,8 +227,15 @@ def _descend(prob: _Problem, steps: int, subset=None, active=None, centres=None)
     """Gradient steps; the largest move is ``STEP`` h, per region when ``centres``
     are given (every sample belongs to its nearest centre), so that a region
     far from the others moves at its own pace."""
-    h = prob.h
     prob.forget()
+    try:
+        _steps(prob, steps, subset, active, centres)
+    finally:
+        prob.forget()  # the samples moved: the next status computes the watch set anew
+
+
+def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
+    h = prob.h
     label = None
     if centres is not None and len(centres) > 1:
         _, label = cKDTree(np.asarray(centres)).query(prob.uv)
@@ -261,7 +269,6 @@ def _descend(prob: _Problem, steps: int, subset=None, active=None, centres=None)
 
 
 def _status(prob: _Problem, subset=None, active=None):
-    prob.forget()
     energy, _, rho, tri = _energy(prob, subset, active)
     bad = tri[rho > BAD] if rho.size else tri[:0]
     return int(bad.shape[0]), energy, bad, (float(rho.max()) if rho.size else 0.0)
