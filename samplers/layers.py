@@ -285,14 +285,12 @@ def _slanted_lines(occ, fi, face, to2d, row_dir, s: Samples, raster, h, nbrs) ->
         if c < 1e-6 or c > 1 - 1e-6:
             continue
         a2, b2 = to2d(np.stack([a3, b3]))
-        d2 = (b2 - a2) / np.linalg.norm(b2 - a2)
-        m = np.array([-d2[1], d2[0]])
-        if not raster(((a2 + b2) / 2 + 0.5 * h * m)[None])[0]:
-            m = -m
-        # inward normal of the edge in 3-D, in this face's plane
+        # the edge's normal in the face's plane, in 3-D and in plane coordinates
+        # (to2d is an isometry), turned to point into the face
         m3 = np.cross(n, u)
-        if (to2d((a3 + m3 * h)[None])[0] - a2) @ m < 0:
-            m3 = -m3
+        m = to2d((a3 + m3)[None])[0] - a2
+        if not raster(((a2 + b2) / 2 + 0.5 * h * m)[None])[0]:
+            m, m3 = -m, -m3
         sel = np.flatnonzero((s.face_id == fb) & ~s.on_feature)
         q = s.points[sel]
         t = (q - a3) @ u
