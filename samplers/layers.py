@@ -104,6 +104,7 @@ class _Arc:
     start: float  # the arc runs from angle start to start + span (0, 2 pi when closed)
     span: float
     closed: bool
+    slides: bool  # its samples slide along it (it bounds a full cylinder)
 
     def distance(self, p: np.ndarray) -> np.ndarray:
         return np.abs(np.linalg.norm(p - self.centre, axis=1) - self.radius)
@@ -121,22 +122,32 @@ class _Arc:
         return self.centre + self.radius * np.stack([np.cos(ang), np.sin(ang)], axis=1)
 
 
-def _arcs(face, to2d) -> list[_Arc]:
+def _arcs(face, to2d, across=()) -> list[_Arc]:
+    """The circular edges of a planar face.  ``across`` (its edges and the
+    face on the other side, from :func:`_neighbours`) tells which arcs bound
+    a full cylinder: only their samples slide.  The cylinder is laid out
+    from its rims afterwards, column under column, whatever their gaps; a
+    cone's rings shrink towards its apex and need an evenly spaced rim
+    (sliding it opened the cone's reconstruction), and so do the partial
+    surfaces left to the scan rows (measured: cone 5.1 % -> 2.2 % violating
+    samples, conebox 2.8 -> 1.8, fillet_box 3.0 -> 2.3)."""
     out = []
     for e in face.Edges():
         if e.geomType() != "CIRCLE":
             continue
+        other = next((f for x, f in across if x.isSame(e)), None)
+        slides = other is not None and other.geomType() == "CYLINDER" and _goes_round(other)
         c = to2d(np.array([e.arcCenter().toTuple()]))[0]
         r = float(e.radius())
         if e.IsClosed():
-            out.append(_Arc(c, r, 0.0, 2 * math.pi, True))
+            out.append(_Arc(c, r, 0.0, 2 * math.pi, True, slides))
             continue
         s, m, f = (to2d(np.array([e.positionAt(x).toTuple()]))[0] - c for x in (0.0, 0.5, 1.0))
         a0, am, a1 = (math.atan2(q[1], q[0]) for q in (s, m, f))
         span = (a1 - a0) % (2 * math.pi)
         if (am - a0) % (2 * math.pi) > span:  # the arc runs the other way round
             a0, span = a1, 2 * math.pi - span
-        out.append(_Arc(c, r, a0, span, False))
+        out.append(_Arc(c, r, a0, span, False, slides))
     return out
 
 
@@ -345,7 +356,8 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -
     reports = []
     done: dict[tuple, object] = {}
     tol = 1e-7 * size
-    nbrs = _neighbours(occ) if row_dirs is not None else None
+    nbrs = _neighbours(occ)
+    faces = occ.Faces()
     for fi, face in enumerate(occ.Faces()):
         if face.geomType() != "PLANE":
             continue
@@ -355,7 +367,7 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -
             q = np.asarray(p, dtype=np.float64) - o
             return np.stack([q @ u, q @ v], axis=1)
 
-        arcs = _arcs(face, to2d)
+        arcs = _arcs(face, to2d, [(e, faces[fb]) for e, fb in nbrs[fi] if fb >= 0])
         if not arcs and row_dirs is None:
             continue
         seg = _boundary_segments(face, to2d, h / 20)
@@ -386,7 +398,10 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -
             cKDTree(corners).query(uv)[0] < tol if corners.shape[0] else np.zeros(len(uv), bool)
         )
         feat = s.on_feature[idx]
-        slide = feat & (near_arc < tol) & ~at_corner
+        near_sliding = np.min(
+            np.stack([far] + [a.distance(uv) for a in arcs if a.slides], axis=1), axis=1
+        )
+        slide = feat & (near_sliding < tol) & ~at_corner
         free = ~feat & ((near_arc < LAYER * h) | (near_line < LAYER * h))
         if not (free.any() or slide.any()):
             continue
@@ -396,7 +411,9 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -
             uv.round(12).tobytes(),
             slide.tobytes(),
             free.tobytes(),
-            tuple((tuple(a.centre.round(12)), round(a.radius, 12), a.closed) for a in arcs),
+            tuple(
+                (tuple(a.centre.round(12)), round(a.radius, 12), a.closed, a.slides) for a in arcs
+            ),
             frame.round(12).tobytes(),
         )
         if key not in done:

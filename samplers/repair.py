@@ -206,7 +206,8 @@ def _energy(prob: _Problem, subset=None, active=None):
     # circumradius R = abc / (4 area): penalise holes in the coverage
     cross = vec[:, 0, 0] * (-vec[:, 2, 1]) - vec[:, 0, 1] * (-vec[:, 2, 0])
     area = 0.5 * np.abs(cross)
-    radius = length.prod(axis=1) / np.maximum(4.0 * area, 1e-300)
+    # (capped: a sliver's radius would overflow the square below)
+    radius = np.minimum(length.prod(axis=1) / np.maximum(4.0 * area, 1e-300), 1e6 * h)
     wide = np.maximum(0.0, radius - WIDE * h) / h
     energy += float((wide**2).sum())
     # a simple gradient for the radius term: pull the triangle's corners to its centroid
