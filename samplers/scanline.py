@@ -238,7 +238,13 @@ def _chains(edges, tol: float) -> list[tuple[list[tuple[Any, bool]], bool]]:
 
 
 def _sample_chain(
-    chain, closed: bool, step: float, anchor: np.ndarray, axis_steps=None
+    chain,
+    closed: bool,
+    step: float,
+    anchor: np.ndarray,
+    axis_steps=None,
+    edge_lattices=(),
+    ratio: float = 1.0,
 ) -> np.ndarray:
     """Samples along a chain of edges, about ``step`` apart.
 
@@ -246,9 +252,15 @@ def _sample_chain(
     direction, measured from ``anchor`` (the shape's bounding-box minimum),
     is a multiple of ``step`` (plus both ends): parallel scan lines
     of a planar face then share one lattice, the rectangular lattice of
-    Figure 1, instead of staggered rows.  Any other chain is sampled at
-    equal arc-length steps from its start (for a closed section of a surface
-    of revolution: from the seam, so rows line up too).
+    Figure 1, instead of staggered rows.  A segment along no coordinate
+    axis but parallel to one of its face's sampled straight edges
+    (``edge_lattices``, from :func:`_feature_samples`) takes the lattice of
+    the nearest such edge instead (anchored at its start, ``ratio`` times
+    its step), so that the row next to the edge does not stagger against
+    the edge's samples (a star prism's sides, a wedge's slanted faces).
+    Any other chain is sampled at equal arc-length steps from its start
+    (for a closed section of a surface of revolution: from the seam, so
+    rows line up too).
     """
     if len(chain) == 1 and not closed and chain[0][0].geomType() == "LINE":
         e = chain[0][0]
@@ -263,6 +275,13 @@ def _sample_chain(
             k = int(np.argmax(np.abs(u)))
             if abs(abs(u[k]) - 1.0) < 1e-12:
                 step = float(axis_steps[k])
+            else:
+                par = [(ea, es) for ea, eu, es in edge_lattices if abs(abs(eu @ u) - 1.0) < 1e-9]
+                if par:
+                    mid = (a + b) / 2
+                    off = [np.linalg.norm((mid - ea) - ((mid - ea) @ u) * u) for ea, _ in par]
+                    anchor, es = par[int(np.argmin(off))]
+                    step = ratio * es
         c0 = float((a - anchor) @ u)
         first = math.ceil(c0 / step - 1e-9)
         last = math.floor((c0 + length) / step + 1e-9)
@@ -313,7 +332,13 @@ def _drop_near_features(points, on_line, feature_curve, radius):
 
 
 def _feature_samples(occ, step: float, sharp_degrees: float, tol: float):
-    """Samples on B-rep vertices and on sharp or boundary edges."""
+    """Samples on B-rep vertices and on sharp or boundary edges.
+
+    Returns the samples, their faces, a dense polyline of the sampled edges,
+    and per face the lattice of each of its sampled straight edges (start,
+    unit direction, step): a straight edge of length L is divided into
+    ``round(L / step)`` equal steps from its start.
+    """
     import cadquery as cq
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
     from OCP.TopExp import TopExp
@@ -329,6 +354,7 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float):
     edge_pts: list[np.ndarray] = []
     edge_fid: list[int] = []
     dense: list[tuple[float, float, float]] = [tuple(p) for p in vertex_pts]
+    lattices: dict[int, list[tuple[np.ndarray, np.ndarray, float]]] = {}
     for i in range(1, emap.Extent() + 1):
         edge = cq.Edge(emap.FindKey(i))
         length = edge.Length()
@@ -349,6 +375,11 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float):
         elif len(uniq) != 1 or len(adj) != 1:
             continue  # a seam edge (one face on both sides): sampled by scan lines
         m = max(1, int(round(length / step)))
+        if edge.geomType() == "LINE":
+            a = np.array(edge.startPoint().toTuple())
+            u = (np.array(edge.endPoint().toTuple()) - a) / length
+            for f in uniq:
+                lattices.setdefault(_index_of(f, faces), []).append((a, u, length / m))
         for j in range(1, m):
             edge_pts.append(np.array(edge.positionAt(j / m, mode="length").toTuple()))
             edge_fid.append(first)
@@ -359,7 +390,7 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float):
         fid.append(_nearest_face(p, faces))
     pts += edge_pts
     fid += edge_fid
-    return pts, fid, np.array(dense, dtype=np.float64).reshape(-1, 3)
+    return pts, fid, np.array(dense, dtype=np.float64).reshape(-1, 3), lattices
 
 
 def _index_of(face, faces) -> int:
@@ -522,7 +553,7 @@ def scan(
 
     # rows along a coordinate axis: r times that axis's plane spacing
     axis_steps = ratio * np.array([_dividing_step(float(e), h) for e in hi - lo])
-    pts, fids, feature_curve = _feature_samples(occ, EDGE_STEP * h, sharp_degrees, tol)
+    pts, fids, feature_curve, lattices = _feature_samples(occ, EDGE_STEP * h, sharp_degrees, tol)
     n_feature = len(pts)
     line_ids = [-1] * n_feature
     line = 0
@@ -549,7 +580,9 @@ def scan(
             origin = d * t
             edges = _section(face, tuple(origin), tuple(d))
             for chain, closed in _chains(edges, max(tol, 1e-9)):
-                p = _sample_chain(chain, closed, ratio * hf, lo, axis_steps)
+                p = _sample_chain(
+                    chain, closed, ratio * hf, lo, axis_steps, lattices.get(fi, ()), ratio
+                )
                 pts.extend(p)
                 fids.extend([fi] * len(p))
                 line_ids.extend([line] * len(p))
