@@ -57,6 +57,7 @@ AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 EDGE_STEP = 1.0  # spacing of corner/edge samples, times h
 FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times h
 FILL_RADIUS = 1.0  # gaps wider than this (times h) get extra samples
+SLANT_STEP = 1.45  # slanted edges are sampled where rows cross them this close (times h)
 RATIO_RANGE = (0.6, 1.7)  # inside (1/sqrt(3), sqrt(3)) = (0.577, 1.732) with margin
 
 
@@ -331,13 +332,87 @@ def _drop_near_features(points, on_line, feature_curve, radius):
     return keep
 
 
-def _feature_samples(occ, step: float, sharp_degrees: float, tol: float):
+def _columns(face, d, hf, ratio, anchor, axis_steps):
+    """The planes through a planar face's columns, as :func:`_sample_chain`
+    places samples along its rows (normal, offset, spacing); None for a
+    curved face or one with a straight edge parallel to its rows (those
+    rows take that edge's samples as columns)."""
+    if face.geomType() != "PLANE":
+        return None
+    rows = np.cross(np.array(face.normalAt().toTuple()), d)
+    if np.linalg.norm(rows) < 1e-9:
+        return None
+    rows /= np.linalg.norm(rows)
+    for e in face.Edges():
+        if e.geomType() == "LINE":
+            t = np.array(e.endPoint().toTuple()) - np.array(e.startPoint().toTuple())
+            if abs(abs(float(t @ rows)) - np.linalg.norm(t)) <= 1e-9 * np.linalg.norm(t):
+                return None
+    k = int(np.argmax(np.abs(rows)))
+    if abs(abs(rows[k]) - 1.0) < 1e-12:
+        axis = np.zeros(3)
+        axis[k] = 1.0
+        return axis, float(anchor[k]), float(axis_steps[k])
+    return rows, float(anchor @ rows), ratio * hf
+
+
+def _row_crossings(a, u, length, adjacent, faces, planes, step):
+    """Where the lattice lines of an adjacent planar face cross a straight
+    edge slanted to that face's rows, if they cross it at most ``SLANT_STEP``
+    steps apart (the densest crossing wins, the first face and rows before
+    columns on ties).
+
+    The lattice lines are the face's scan planes (normal, offset, spacing)
+    and, where known, the planes through its columns (the sample positions
+    along the rows).  Sampled at their crossings, the edge holds the ends of
+    that face's rows or columns, which then end on edge samples instead of
+    staggering against equal arc-length ones.  Returns the arc lengths of
+    the crossings (none nearer than ``step`` / 2 to either end, where the
+    corners are) and their spacing, or None.
+    """
+    if planes is None:
+        return None
+    best = None
+    for f in adjacent:
+        if f.geomType() != "PLANE":
+            continue
+        fi = _index_of(f, faces)
+        d, t0, hf, columns = planes[fi]
+        rows = np.cross(np.array(f.normalAt().toTuple()), d)
+        if np.linalg.norm(rows) < 1e-9:
+            continue
+        along = abs(float(u @ rows)) / float(np.linalg.norm(rows))
+        if along < 1e-6 or along > 1 - 1e-6:
+            continue  # rows parallel or perpendicular to the edge: equal steps fit
+        for normal, offset, gap in [(d, t0, hf)] + ([columns] if columns else []):
+            un = float(u @ normal)
+            if abs(un) < 1e-9:
+                continue
+            spacing = gap / abs(un)
+            if spacing > SLANT_STEP * step or (best is not None and spacing >= best[0] - 1e-12):
+                continue
+            ends = sorted((float(a @ normal), float((a + length * u) @ normal)))
+            j = np.arange(
+                math.ceil((ends[0] - offset) / gap - 1e-9),
+                math.floor((ends[1] - offset) / gap + 1e-9) + 1,
+            )
+            sj = np.sort((offset + j * gap - float(a @ normal)) / un)
+            sj = sj[(sj >= step / 2) & (sj <= length - step / 2)]
+            best = (spacing, sj)
+    if best is None or best[1].size == 0:
+        return None
+    return best[1], best[0]
+
+
+def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=None):
     """Samples on B-rep vertices and on sharp or boundary edges.
 
     Returns the samples, their faces, a dense polyline of the sampled edges,
     and per face the lattice of each of its sampled straight edges (start,
     unit direction, step): a straight edge of length L is divided into
-    ``round(L / step)`` equal steps from its start.
+    ``round(L / step)`` equal steps from its start, unless ``planes`` (per
+    face, its scan planes' normal, offset and spacing) show it slanted to an
+    adjacent planar face's rows (:func:`_row_crossings`).
     """
     import cadquery as cq
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
@@ -375,14 +450,22 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float):
         elif len(uniq) != 1 or len(adj) != 1:
             continue  # a seam edge (one face on both sides): sampled by scan lines
         m = max(1, int(round(length / step)))
+        cross = None
         if edge.geomType() == "LINE":
             a = np.array(edge.startPoint().toTuple())
             u = (np.array(edge.endPoint().toTuple()) - a) / length
+            cross = _row_crossings(a, u, length, uniq, faces, planes, step)
+            lattice = (a, u, length / m) if cross is None else (a + cross[0][0] * u, u, cross[1])
             for f in uniq:
-                lattices.setdefault(_index_of(f, faces), []).append((a, u, length / m))
-        for j in range(1, m):
-            edge_pts.append(np.array(edge.positionAt(j / m, mode="length").toTuple()))
-            edge_fid.append(first)
+                lattices.setdefault(_index_of(f, faces), []).append(lattice)
+        if cross is not None:
+            for sj in cross[0]:
+                edge_pts.append(a + sj * u)
+                edge_fid.append(first)
+        else:
+            for j in range(1, m):
+                edge_pts.append(np.array(edge.positionAt(j / m, mode="length").toTuple()))
+                edge_fid.append(first)
         md = max(2, int(math.ceil(8 * length / step)))
         dense += [edge.positionAt(j / md, mode="length").toTuple() for j in range(md + 1)]
     for p in vertex_pts:
@@ -553,7 +636,15 @@ def scan(
 
     # rows along a coordinate axis: r times that axis's plane spacing
     axis_steps = ratio * np.array([_dividing_step(float(e), h) for e in hi - lo])
-    pts, fids, feature_curve, lattices = _feature_samples(occ, EDGE_STEP * h, sharp_degrees, tol)
+    planes = []
+    for fi, face in enumerate(faces):
+        d = dirs[fam[fi]]
+        t0 = float((corner @ d).min())
+        hf = _dividing_step(float((corner @ d).max()) - t0, h)
+        planes.append((d, t0, hf, _columns(face, d, hf, ratio, lo, axis_steps)))
+    pts, fids, feature_curve, lattices = _feature_samples(
+        occ, EDGE_STEP * h, sharp_degrees, tol, planes
+    )
     n_feature = len(pts)
     line_ids = [-1] * n_feature
     line = 0

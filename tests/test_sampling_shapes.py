@@ -100,7 +100,8 @@ def test_cone_rim_stays_evenly_spaced(sampled):
 def test_rows_parallel_to_a_slanted_edge_share_its_lattice(sampled):
     """A star prism's sides run along no axis: their rows take the samples of
     the sides' horizontal edges as columns (they once staggered against them
-    by a fraction of a step: 14.5% of the samples broke Condition III-ii)."""
+    by a fraction of a step: 14.5% of the samples broke Condition III-ii).
+    The corners stay where they are, off that lattice."""
     s, r = sampled["star_prism"]
     p = r.points
     sides = 0
@@ -114,11 +115,69 @@ def test_rows_parallel_to_a_slanted_edge_share_its_lattice(sampled):
         u = np.array(edge.endPoint().toTuple()) - a
         length = np.linalg.norm(u)
         u /= length
-        step = length / round(length / r.meta["spacing"])
-        k = (p[r.face_id == fi] - a) @ u / step
+        # the edge's own samples (where the star end's lattice lines cross it)
+        t = (p - a) @ u
+        on = r.on_feature & (np.linalg.norm(p - a - t[:, None] * u, axis=1) < 1e-9)
+        q = np.sort(t[on & (t > 1e-9) & (t < length - 1e-9)])
+        step = q[1] - q[0]
+        np.testing.assert_allclose(np.diff(q), step, rtol=1e-9)
+        # (a gap-filling sample, line -2, may sit between a column and a corner)
+        tf = t[(r.face_id == fi) & (r.line_id >= 0) & (t > 1e-9) & (t < length - 1e-9)]
+        k = (tf - q[0]) / step
         assert k.size > 100
         np.testing.assert_allclose(k, np.round(k), atol=1e-6)
     assert sides == 10
+
+
+def test_slanted_edges_hold_the_ends_of_their_faces_lattice_lines(sampled):
+    """A pyramid's lateral edges run slanted to the rows of both faces they
+    bound: they are sampled where one face's lattice lines (its rows, or the
+    columns along them) cross them, at most 1.45 h apart, so that those
+    lines end on edge samples."""
+    s, r = sampled["pyramid"]
+    p, h = r.points, r.meta["spacing"]
+    dirs = np.asarray(r.meta["directions"])
+    faces = s.solid.Faces()
+    lattice = {}
+    for fi, face in enumerate(faces):
+        n = np.array(face.normalAt().toTuple())
+        d = dirs[r.meta["face_directions"][fi]]
+        rows = np.cross(n, d)
+        rows /= np.linalg.norm(rows)
+        # the face's samples well inside it keep the lattice untouched
+        mine = p[(r.face_id == fi) & ~r.on_feature]
+        inner = mine[cKDTree(p[r.on_feature]).query(mine)[0] > 4 * h]
+        lines = []
+        for normal in (d, rows):
+            c = inner @ normal
+            step = np.min(np.diff(np.unique(np.round(c, 9))))
+            lines.append((normal, c[0], step))
+        lattice[fi] = lines
+    slanted = 0
+    for e in s.solid.Edges():
+        a = np.array(e.startPoint().toTuple())
+        u = np.array(e.endPoint().toTuple()) - a
+        length = np.linalg.norm(u)
+        u /= length
+        if abs(u[2]) < 1e-9:
+            continue  # the base's edges run along the rows or across them
+        slanted += 1
+        t = (p - a) @ u
+        on = r.on_feature & (np.linalg.norm(p - a - t[:, None] * u, axis=1) < 1e-9)
+        on &= (t > 1e-9) & (t < length - 1e-9)
+        q = np.sort(t[on])
+        gaps = np.diff(q)
+        np.testing.assert_allclose(gaps, gaps[0], rtol=1e-9)
+        assert h <= gaps[0] <= 1.45 * h
+        assert q[0] >= h / 2 and length - q[-1] >= h / 2
+        adjacent = [fi for fi, f in enumerate(faces) if any(e.isSame(x) for x in f.Edges())]
+        ends = [
+            np.allclose(((p[on] @ nrm - c0) / step + 0.5) % 1.0, 0.5, atol=1e-6)
+            for fi in adjacent
+            for nrm, c0, step in lattice[fi]
+        ]
+        assert any(ends)
+    assert slanted == 4
 
 
 def test_repaired_boundary_layer_cuts_condition_iii_violations(sampled):
