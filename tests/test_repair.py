@@ -90,3 +90,10 @@ def test_ring_of_equal_gaps_ends_every_other_column():
     np.testing.assert_array_equal(out, ang[1::2])  # after the widest gap (the first, on ties)
     wide = 1.2 * 40 / (2 * math.pi)  # gaps of 1.2 t: nothing ends
     np.testing.assert_array_equal(_end_columns(ang, wide, 1.0), ang)
+
+
+def test_halving_counts_are_three_four_or_five_times_a_power_of_two():
+    from samplers.layers import _halving_count
+
+    got = [_halving_count(x) for x in (1, 3, 4.4, 5.6, 7, 9, 11, 14, 25, 50, 100, 125, 170)]
+    assert got == [3, 3, 4, 6, 8, 10, 12, 16, 24, 48, 96, 128, 160]

@@ -236,6 +236,15 @@ def test_revolved_body_is_laid_out_in_rings():
     step = 2 * math.pi / rep["columns"]
     k = ang / step - ang[0] / step
     assert np.abs(k - np.round(k)).max() < 1e-6  # every column is one of the widest ring's
+    # the widest ring halves down to the poles: 3, 4 or 5 times a power of two columns,
+    # and the rings next to the poles (the apex, the ball's top) have at most 5
+    c = rep["columns"]
+    while c % 2 == 0 and c > 5:
+        c //= 2
+    assert c in (3, 4, 5)
+    rings = np.unique(z)
+    for end in (rings[0], rings[-1]):
+        assert 3 <= np.count_nonzero(z == end) <= 5
     from validators.fidelity import distance_to_surface
 
     d = distance_to_surface(r.points, s.truth_vertices, s.truth_triangles)
