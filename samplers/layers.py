@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .adjacency import EdgeFaces
 from .repair import repair
 
 LAYER = 2.5  # samples within this many h of a circular edge may move
@@ -124,7 +125,7 @@ class _Arc:
 
 def _arcs(face, to2d, across=()) -> list[_Arc]:
     """The circular edges of a planar face.  ``across`` (its edges and the
-    face on the other side, from :func:`_neighbours`) tells which arcs bound
+    face on the other side, from :meth:`EdgeFaces.across`) tells which arcs bound
     a full cylinder: only their samples slide.  The cylinder is laid out
     from its rims afterwards, column under column, whatever their gaps; a
     cone's rings shrink towards its apex and need an evenly spaced rim
@@ -254,24 +255,6 @@ class _Line:
         return np.linalg.norm(p - (self.a + t[:, None] * d), axis=1)
 
 
-def _neighbours(occ) -> list[list[tuple[object, int]]]:
-    """Per face, its edges and the index of the face on the other side (-1: none)."""
-    faces = occ.Faces()
-    edges = [f.Edges() for f in faces]
-    out = []
-    for fi, mine in enumerate(edges):
-        row = []
-        for e in mine:
-            other = -1
-            for fj, theirs in enumerate(edges):
-                if fj != fi and any(e.isSame(x) for x in theirs):
-                    other = fj
-                    break
-            row.append((e, other))
-        out.append(row)
-    return out
-
-
 def _slanted_lines(occ, fi, face, to2d, row_dir, s: Samples, raster, h, nbrs) -> list[_Line]:
     """Sharp straight edges of a planar face, between it and another planar
     face, neither parallel nor perpendicular to the face's scan rows (those
@@ -356,7 +339,7 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -
     reports = []
     done: dict[tuple, object] = {}
     tol = 1e-7 * size
-    nbrs = _neighbours(occ)
+    nbrs = EdgeFaces(occ).across()
     faces = occ.Faces()
     for fi, face in enumerate(occ.Faces()):
         if face.geomType() != "PLANE":

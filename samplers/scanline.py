@@ -53,6 +53,8 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .adjacency import EdgeFaces, face_index
+
 AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 EDGE_STEP = 1.0  # spacing of corner/edge samples, times h
 FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times h
@@ -376,7 +378,7 @@ def _row_crossings(a, u, length, adjacent, faces, planes, step):
     for f in adjacent:
         if f.geomType() != "PLANE":
             continue
-        fi = _index_of(f, faces)
+        fi = face_index(f, faces)
         d, t0, hf, columns = planes[fi]
         rows = np.cross(np.array(f.normalAt().toTuple()), d)
         if np.linalg.norm(rows) < 1e-9:
@@ -414,14 +416,8 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
     face, its scan planes' normal, offset and spacing) show it slanted to an
     adjacent planar face's rows (:func:`_row_crossings`).
     """
-    import cadquery as cq
-    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
-    from OCP.TopExp import TopExp
-    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
-
-    faces = occ.Faces()
-    emap = TopTools_IndexedDataMapOfShapeListOfShape()
-    TopExp.MapShapesAndAncestors_s(occ.wrapped, TopAbs_EDGE, TopAbs_FACE, emap)
+    ef = EdgeFaces(occ)
+    faces = ef.faces
     pts: list[np.ndarray] = []
     fid: list[int] = []
     vertex_pts = [np.array(v.toTuple()) for v in occ.Vertices()]
@@ -430,24 +426,19 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
     edge_fid: list[int] = []
     dense: list[tuple[float, float, float]] = [tuple(p) for p in vertex_pts]
     lattices: dict[int, list[tuple[np.ndarray, np.ndarray, float]]] = {}
-    for i in range(1, emap.Extent() + 1):
-        edge = cq.Edge(emap.FindKey(i))
+    for edge, fids, uses in zip(ef.edges, ef.faces_of, ef.uses):
         length = edge.Length()
         if length <= tol:
             continue
-        adj = [cq.Face(f) for f in emap.FindFromIndex(i)]
-        uniq = []
-        for f in adj:
-            if not any(f.isSame(g) for g in uniq):
-                uniq.append(f)
-        first = _index_of(uniq[0], faces) if uniq else -1
+        uniq = [faces[k] for k in fids]
+        first = fids[0] if fids else -1
         if len(uniq) == 2:
             mid = edge.positionAt(0.5, mode="length")
             n1 = np.array(uniq[0].normalAt(mid).toTuple())
             n2 = np.array(uniq[1].normalAt(mid).toTuple())
             if float(n1 @ n2) > cos_lim:
                 continue  # smooth edge (fillet tangency) or seam: sampled by scan lines
-        elif len(uniq) != 1 or len(adj) != 1:
+        elif len(uniq) != 1 or uses != 1:
             continue  # a seam edge (one face on both sides): sampled by scan lines
         m = max(1, int(round(length / step)))
         cross = None
@@ -456,8 +447,8 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
             u = (np.array(edge.endPoint().toTuple()) - a) / length
             cross = _row_crossings(a, u, length, uniq, faces, planes, step)
             lattice = (a, u, length / m) if cross is None else (a + cross[0][0] * u, u, cross[1])
-            for f in uniq:
-                lattices.setdefault(_index_of(f, faces), []).append(lattice)
+            for k in fids:
+                lattices.setdefault(k, []).append(lattice)
         if cross is not None:
             for sj in cross[0]:
                 edge_pts.append(a + sj * u)
@@ -474,13 +465,6 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
     pts += edge_pts
     fid += edge_fid
     return pts, fid, np.array(dense, dtype=np.float64).reshape(-1, 3), lattices
-
-
-def _index_of(face, faces) -> int:
-    for i, f in enumerate(faces):
-        if f.isSame(face):
-            return i
-    return -1
 
 
 def _nearest_face(p, faces) -> int:

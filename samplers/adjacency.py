@@ -1,0 +1,63 @@
+"""Which faces of a B-rep bound which edges (OCC's edge-to-face map).
+
+One map serves both the scan-line sampler (which edges are sharp, which
+faces an edge's samples belong to) and the boundary-layer repair (the face
+across each edge of a planar face).  CadQuery and OCP are imported when
+the functions run.
+"""
+
+from __future__ import annotations
+
+
+def face_index(face, faces) -> int:
+    """Index of ``face`` in ``faces`` (same TShape and location), -1 if absent."""
+    for i, f in enumerate(faces):
+        if f.isSame(face):
+            return i
+    return -1
+
+
+class EdgeFaces:
+    """The shape's edges with the faces on either side.
+
+    ``edges[i]`` is the i-th edge of OCC's map, ``faces_of[i]`` the indices
+    (into ``shape.Faces()``) of the distinct faces it bounds, in the map's
+    order, and ``uses[i]`` how many times faces use it (2 with one face is
+    a seam).
+    """
+
+    def __init__(self, occ):
+        import cadquery as cq
+        from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+        from OCP.TopExp import TopExp
+        from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+        self.faces = occ.Faces()
+        self._map = TopTools_IndexedDataMapOfShapeListOfShape()
+        TopExp.MapShapesAndAncestors_s(occ.wrapped, TopAbs_EDGE, TopAbs_FACE, self._map)
+        self.edges = []
+        self.faces_of: list[list[int]] = []
+        self.uses: list[int] = []
+        for i in range(1, self._map.Extent() + 1):
+            self.edges.append(cq.Edge(self._map.FindKey(i)))
+            adj = [cq.Face(f) for f in self._map.FindFromIndex(i)]
+            uniq: list[int] = []
+            for f in adj:
+                k = face_index(f, self.faces)
+                if k not in uniq:
+                    uniq.append(k)
+            self.faces_of.append(uniq)
+            self.uses.append(len(adj))
+
+    def across(self) -> list[list[tuple[object, int]]]:
+        """Per face, each of its edges (in the face's order) and the lowest
+        index of another face bounded by it (-1: none, a boundary or a seam)."""
+        out = []
+        for fi, face in enumerate(self.faces):
+            row = []
+            for e in face.Edges():
+                k = self._map.FindIndex(e.wrapped)
+                others = [j for j in self.faces_of[k - 1] if j != fi] if k > 0 else []
+                row.append((e, min(others) if others else -1))
+            out.append(row)
+        return out
