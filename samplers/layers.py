@@ -249,10 +249,14 @@ class _Line:
     inward: np.ndarray  # 2-D unit normal pointing into the face
     frame: np.ndarray  # the neighbouring face's samples near the edge, unfolded (2-D)
 
-    def distance(self, p: np.ndarray) -> np.ndarray:
+    def along(self, p: np.ndarray) -> np.ndarray:
+        """The edge parameter of each point's foot (0 at ``a``, 1 at ``b``)."""
         d = self.b - self.a
-        t = np.clip((p - self.a) @ d / (d @ d), 0.0, 1.0)
-        return np.linalg.norm(p - (self.a + t[:, None] * d), axis=1)
+        return (p - self.a) @ d / (d @ d)
+
+    def distance(self, p: np.ndarray) -> np.ndarray:
+        t = np.clip(self.along(p), 0.0, 1.0)
+        return np.linalg.norm(p - (self.a + t[:, None] * (self.b - self.a)), axis=1)
 
 
 def _slanted_lines(occ, fi, face, to2d, row_dir, s: Samples, raster, h, nbrs) -> list[_Line]:
@@ -313,8 +317,7 @@ def _clamp_lines(lines: list[_Line], h: float):
     def clamp(p: np.ndarray) -> np.ndarray:
         out = p.copy()
         for ln in lines:
-            d = ln.b - ln.a
-            t = (out - ln.a) @ d / (d @ d)
+            t = ln.along(out)
             inward = (out - ln.a) @ ln.inward
             bad = (t > 0) & (t < 1) & (inward < 0.4 * h) & (inward > -2 * h)
             if bad.any():
