@@ -342,9 +342,10 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -
     reports = []
     done: dict[tuple, object] = {}
     tol = 1e-7 * size
-    nbrs = EdgeFaces(occ).across()
-    faces = occ.Faces()
-    for fi, face in enumerate(occ.Faces()):
+    adjacency = EdgeFaces(occ)
+    nbrs = adjacency.across()
+    faces = adjacency.faces
+    for fi, face in enumerate(faces):
         if face.geomType() != "PLANE":
             continue
         o, u, v, n = _plane_frame(face)

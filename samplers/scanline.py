@@ -53,7 +53,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .adjacency import EdgeFaces, face_index
+from .adjacency import EdgeFaces
 
 AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 EDGE_STEP = 1.0  # spacing of corner/edge samples, times h
@@ -359,10 +359,10 @@ def _columns(face, d, hf, ratio, anchor, axis_steps):
 
 
 def _row_crossings(a, u, length, adjacent, faces, planes, step):
-    """Where the lattice lines of an adjacent planar face cross a straight
-    edge slanted to that face's rows, if they cross it at most ``SLANT_STEP``
-    steps apart (the densest crossing wins, the first face and rows before
-    columns on ties).
+    """Where the lattice lines of an adjacent planar face (``adjacent``:
+    indices into ``faces``) cross a straight edge slanted to that face's
+    rows, if they cross it at most ``SLANT_STEP`` steps apart (the densest
+    crossing wins, the first face and rows before columns on ties).
 
     The lattice lines are the face's scan planes (normal, offset, spacing)
     and, where known, the planes through its columns (the sample positions
@@ -375,10 +375,10 @@ def _row_crossings(a, u, length, adjacent, faces, planes, step):
     if planes is None:
         return None
     best = None
-    for f in adjacent:
+    for fi in adjacent:
+        f = faces[fi]
         if f.geomType() != "PLANE":
             continue
-        fi = face_index(f, faces)
         d, t0, hf, columns = planes[fi]
         rows = np.cross(np.array(f.normalAt().toTuple()), d)
         if np.linalg.norm(rows) < 1e-9:
@@ -445,7 +445,7 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
         if edge.geomType() == "LINE":
             a = np.array(edge.startPoint().toTuple())
             u = (np.array(edge.endPoint().toTuple()) - a) / length
-            cross = _row_crossings(a, u, length, uniq, faces, planes, step)
+            cross = _row_crossings(a, u, length, fids, faces, planes, step)
             lattice = (a, u, length / m) if cross is None else (a + cross[0][0] * u, u, cross[1])
             for k in fids:
                 lattices.setdefault(k, []).append(lattice)
@@ -620,10 +620,12 @@ def scan(
 
     # rows along a coordinate axis: r times that axis's plane spacing
     axis_steps = ratio * np.array([_dividing_step(float(e), h) for e in hi - lo])
-    planes = []
+    planes = []  # per face: its family's direction, first plane, spacing, columns
     for fi, face in enumerate(faces):
         d = dirs[fam[fi]]
         t0 = float((corner @ d).min())
+        # the family's spacing divides the shape's extent along d, so the
+        # last plane meets the far side as the first meets the near side
         hf = _dividing_step(float((corner @ d).max()) - t0, h)
         planes.append((d, t0, hf, _columns(face, d, hf, ratio, lo, axis_steps)))
     pts, fids, feature_curve, lattices = _feature_samples(
@@ -633,11 +635,7 @@ def scan(
     line_ids = [-1] * n_feature
     line = 0
     for fi, face in enumerate(faces):
-        d = dirs[fam[fi]]
-        t0 = float((corner @ d).min())
-        # the family's spacing divides the shape's extent along d, so the
-        # last plane meets the far side as the first meets the near side
-        hf = _dividing_step(float((corner @ d).max()) - t0, h)
+        d, t0, hf, _ = planes[fi]
         flo, fhi = _exact_bounds(face)
         fc = np.array(
             [
