@@ -248,6 +248,7 @@ def _sample_chain(
     axis_steps=None,
     edge_lattices=(),
     ratio: float = 1.0,
+    sphere=None,
 ) -> np.ndarray:
     """Samples along a chain of edges, about ``step`` apart.
 
@@ -261,9 +262,10 @@ def _sample_chain(
     the nearest such edge instead (anchored at its start, ``ratio`` times
     its step), so that the row next to the edge does not stagger against
     the edge's samples (a star prism's sides, a wedge's slanted faces).
-    Any other chain is sampled at equal arc-length steps from its start
-    (for a closed section of a surface of revolution: from the seam, so
-    rows line up too).
+    An open section of a partial sphere (``sphere``, from
+    :func:`_sphere_frame`) is sampled by :func:`_sphere_row`.  Any other
+    chain is sampled at equal arc-length steps from its start (for a closed
+    section of a surface of revolution: from the seam, so rows line up too).
     """
     if len(chain) == 1 and not closed and chain[0][0].geomType() == "LINE":
         e = chain[0][0]
@@ -292,6 +294,8 @@ def _sample_chain(
         s = s[(s > 1e-9 * length) & (s < length * (1 - 1e-9))]
         s = np.concatenate([[0.0], s, [length]])
         return a + s[:, None] * u
+    if sphere is not None and not closed:
+        return _sphere_row(chain, step, sphere)
     lengths = np.array([e.Length() for e, _ in chain])
     total = float(lengths.sum())
     m = max(1, int(round(total / step)))
@@ -310,6 +314,68 @@ def _sample_chain(
             frac = 1.0 - frac
         out[i] = e.positionAt(frac, mode="length").toTuple()
     return out
+
+
+def _sphere_frame(face, d: np.ndarray):
+    """(centre, radius, e1, e2) of a sphere face that does not go all the way
+    round, with e1, e2 completing the scan direction ``d`` to a frame; None
+    for any other face."""
+    from .layers import _goes_round
+
+    if face.geomType() != "SPHERE" or _goes_round(face):
+        return None
+    sph = face._geomAdaptor().Sphere()
+    centre = np.array(sph.Location().Coord())
+    e1 = np.cross(d, np.eye(3)[int(np.argmin(np.abs(d)))])
+    e1 /= np.linalg.norm(e1)
+    return centre, float(sph.Radius()), e1, np.cross(d, e1), d
+
+
+def _sphere_row(chain, step: float, sphere) -> np.ndarray:
+    """Samples of an open section of a partial sphere: its ends, and the
+    points between them at multiples of one angle about the scan direction
+    through the sphere's centre.
+
+    The angle is ``step / R`` times the power of two that keeps the row's
+    gaps in [0.75, 1.5) ``step`` (R: the sphere's radius), so the rows of the
+    face share their columns, every other one ending where a row's gaps
+    would fall below 0.75 ``step``, instead of staggering (rows sampled from
+    their own starts made near-equilateral triangles all over fillet_box's
+    corners and cutcube's scoop).
+    """
+    centre, radius, e1, e2, d = sphere
+    ends = []
+    for (e, rev), at in ((chain[0], 0.0), (chain[-1], 1.0)):
+        ends.append(np.array((e.endPoint() if rev != (at == 1.0) else e.startPoint()).toTuple()))
+    lengths = np.array([e.Length() for e, _ in chain])
+    half = lengths.sum() / 2
+    j = int(np.searchsorted(np.cumsum(lengths), half))
+    j = min(j, len(chain) - 1)
+    e, rev = chain[j]
+    frac = (half - (lengths[:j].sum())) / lengths[j]
+    mid = np.array(e.positionAt(1.0 - frac if rev else frac, mode="length").toTuple())
+    cc = centre + float((ends[0] - centre) @ d) * d
+    r = float(np.linalg.norm(ends[0] - cc))
+    if r < 1e-12:
+        return np.array(ends)
+
+    def angle(p):
+        q = p - cc
+        return math.atan2(float(q @ e2), float(q @ e1))
+
+    a0, am, a1 = angle(ends[0]), angle(mid), angle(ends[1])
+    span = (a1 - a0) % (2 * math.pi)
+    sign = 1.0 if (am - a0) % (2 * math.pi) <= span else -1.0
+    if sign < 0:
+        span = 2 * math.pi - span
+    dt = step / radius
+    while r * dt < 0.75 * step:
+        dt *= 2
+    lo, hi = (a0, a0 + span) if sign > 0 else (a0 - span, a0)
+    k = np.arange(math.ceil(lo / dt + 1e-9), math.floor(hi / dt - 1e-9) + 1)
+    th = k * dt if sign > 0 else (k * dt)[::-1]
+    inner = cc + r * (np.cos(th)[:, None] * e1 + np.sin(th)[:, None] * e2)
+    return np.vstack([ends[0][None], inner, ends[1][None]])
 
 
 def _drop_near_features(points, on_line, feature_curve, radius):
@@ -636,6 +702,7 @@ def scan(
     line = 0
     for fi, face in enumerate(faces):
         d, t0, hf, _ = planes[fi]
+        sphere = _sphere_frame(face, d)
         flo, fhi = _exact_bounds(face)
         fc = np.array(
             [
@@ -654,7 +721,14 @@ def scan(
             edges = _section(face, tuple(origin), tuple(d))
             for chain, closed in _chains(edges, max(tol, 1e-9)):
                 p = _sample_chain(
-                    chain, closed, ratio * hf, lo, axis_steps, lattices.get(fi, ()), ratio
+                    chain,
+                    closed,
+                    ratio * hf,
+                    lo,
+                    axis_steps,
+                    lattices.get(fi, ()),
+                    ratio,
+                    sphere,
                 )
                 pts.extend(p)
                 fids.extend([fi] * len(p))

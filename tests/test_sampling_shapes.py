@@ -180,6 +180,39 @@ def test_slanted_edges_hold_the_ends_of_their_faces_lattice_lines(sampled):
     assert slanted == 4
 
 
+def test_partial_sphere_rows_share_their_columns(sampled):
+    """fillet_box's corners are sphere octants on plain scan rows: inside each
+    row the samples sit at multiples of one angle about the scan direction
+    through the centre, the finest row's angle dividing every other (rows
+    sampled from their own starts staggered: 21 bad triangles per corner)."""
+    s, r = sampled["fillet_box"]
+    p = r.points
+    dirs = np.asarray(r.meta["directions"])
+    spheres = 0
+    for fi, face in enumerate(s.solid.Faces()):
+        if face.geomType() != "SPHERE":
+            continue
+        spheres += 1
+        centre = np.array(face._geomAdaptor().Sphere().Location().Coord())
+        d = dirs[r.meta["face_directions"][fi]]
+        e1 = np.cross(d, np.eye(3)[int(np.argmin(np.abs(d)))])
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(d, e1)
+        angles, steps = [], []
+        for line in np.unique(r.line_id[(r.face_id == fi) & (r.line_id >= 0)]):
+            q = p[(r.line_id == line) & (r.face_id == fi)] - centre
+            th = np.sort(np.arctan2(q @ e2, q @ e1))[1:-1]  # the row's ends lie on the boundary
+            if th.size >= 2:
+                angles.append(th)
+                steps.append(np.diff(th).min())
+        assert len(angles) >= 3
+        unit = min(steps)
+        for th in angles:
+            k = th / unit
+            np.testing.assert_allclose(k, np.round(k), atol=1e-6)
+    assert spheres == 4
+
+
 def test_repaired_boundary_layer_cuts_condition_iii_violations(sampled):
     """Condition III by the validators' geodesic check (DT_M on the refined truth):
     the rows meeting the hole's rims break III-ii for about 2% of the samples;
