@@ -317,9 +317,9 @@ def _sample_chain(
 
 
 def _sphere_frame(face, d: np.ndarray):
-    """(centre, radius, e1, e2) of a sphere face that does not go all the way
-    round, with e1, e2 completing the scan direction ``d`` to a frame; None
-    for any other face."""
+    """(centre, radius, e1, e2, d) of a sphere face that does not go all the
+    way round, with e1, e2 completing the scan direction ``d`` to a frame;
+    None for any other face."""
     from .layers import _goes_round
 
     if face.geomType() != "SPHERE" or _goes_round(face):
@@ -344,9 +344,11 @@ def _sphere_row(chain, step: float, sphere) -> np.ndarray:
     corners and cutcube's scoop).
     """
     centre, radius, e1, e2, d = sphere
-    ends = []
-    for (e, rev), at in ((chain[0], 0.0), (chain[-1], 1.0)):
-        ends.append(np.array((e.endPoint() if rev != (at == 1.0) else e.startPoint()).toTuple()))
+    (first, rev0), (last, rev1) = chain[0], chain[-1]
+    ends = [
+        np.array((first.endPoint() if rev0 else first.startPoint()).toTuple()),
+        np.array((last.startPoint() if rev1 else last.endPoint()).toTuple()),
+    ]
     lengths = np.array([e.Length() for e, _ in chain])
     half = lengths.sum() / 2
     j = int(np.searchsorted(np.cumsum(lengths), half))
