@@ -225,6 +225,13 @@ def _clamp(arcs: list[_Arc], sides: list[float], h: float):
     return clamp
 
 
+def _perpendicular(v: np.ndarray) -> np.ndarray:
+    """A unit vector perpendicular to ``v``: ``v`` crossed with the coordinate
+    axis least aligned with it (a fixed choice, so frames are reproducible)."""
+    u = np.cross(v, np.eye(3)[int(np.argmin(np.abs(v)))])
+    return u / np.linalg.norm(u)
+
+
 def _plane_frame(face):
     n = np.array(face.normalAt().toTuple())
     k = int(np.argmax(np.abs(n)))
@@ -232,8 +239,7 @@ def _plane_frame(face):
         u = np.eye(3)[(k + 1) % 3]
         v = np.eye(3)[(k + 2) % 3]
     else:
-        u = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
-        u /= np.linalg.norm(u)
+        u = _perpendicular(n)
         v = np.cross(n, u)
     o = np.array(face.Center().toTuple())
     o = n * float(n @ o)  # the plane's point nearest the origin: parallel faces share u, v
@@ -726,8 +732,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         ring.append((fi, z, float(np.linalg.norm(p - z * axis))))
     radial = np.array([r for _, _, r in ring])
     widest = int(np.argmax(radial))
-    ex = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
-    ex /= np.linalg.norm(ex)
+    ex = _perpendicular(axis)
     ey = np.cross(axis, ex)
     m = _halving_count(2 * math.pi * radial[widest] / h)
     columns = {widest: 2 * math.pi * np.arange(m) / m}

@@ -240,6 +240,12 @@ def _chains(edges, tol: float) -> list[tuple[list[tuple[Any, bool]], bool]]:
     return chains
 
 
+def _axis_index(u: np.ndarray) -> int | None:
+    """Which coordinate axis the unit vector ``u`` runs along, if any."""
+    k = int(np.argmax(np.abs(u)))
+    return k if abs(abs(u[k]) - 1.0) < 1e-12 else None
+
+
 def _sample_chain(
     chain,
     closed: bool,
@@ -277,8 +283,8 @@ def _sample_chain(
             # a row along a coordinate axis steps like the planes across that
             # axis (the extent over a whole number of steps), so that its
             # samples meet the corner and edge samples of the faces it crosses
-            k = int(np.argmax(np.abs(u)))
-            if abs(abs(u[k]) - 1.0) < 1e-12:
+            k = _axis_index(u)
+            if k is not None:
                 step = float(axis_steps[k])
             else:
                 par = [(ea, es) for ea, eu, es in edge_lattices if abs(abs(eu @ u) - 1.0) < 1e-9]
@@ -304,30 +310,32 @@ def _sample_chain(
     count = m if closed else m + 1
     s = np.arange(count) * (total / m)
     starts = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
-    out = np.empty((count, 3))
-    for i, si in enumerate(s):
-        j = int(np.searchsorted(starts, si, side="right") - 1)
-        j = min(max(j, 0), len(chain) - 1)
-        e, rev = chain[j]
-        frac = min(max((si - starts[j]) / lengths[j], 0.0), 1.0)
-        if rev:
-            frac = 1.0 - frac
-        out[i] = e.positionAt(frac, mode="length").toTuple()
-    return out
+    return np.array([_chain_point(chain, lengths, starts, si) for si in s]).reshape(-1, 3)
+
+
+def _chain_point(chain, lengths: np.ndarray, starts: np.ndarray, s: float) -> np.ndarray:
+    """The point at arc length ``s`` along a chain of (edge, reversed) whose
+    edges have these lengths and start at these arc lengths."""
+    j = int(np.searchsorted(starts, s, side="right") - 1)
+    j = min(max(j, 0), len(chain) - 1)
+    e, rev = chain[j]
+    frac = min(max((s - starts[j]) / lengths[j], 0.0), 1.0)
+    if rev:
+        frac = 1.0 - frac
+    return np.array(e.positionAt(frac, mode="length").toTuple())
 
 
 def _sphere_frame(face, d: np.ndarray):
     """(centre, radius, e1, e2, d) of a sphere face that does not go all the
     way round, with e1, e2 completing the scan direction ``d`` to a frame;
     None for any other face."""
-    from .layers import _goes_round
+    from .layers import _goes_round, _perpendicular
 
     if face.geomType() != "SPHERE" or _goes_round(face):
         return None
     sph = face._geomAdaptor().Sphere()
     centre = np.array(sph.Location().Coord())
-    e1 = np.cross(d, np.eye(3)[int(np.argmin(np.abs(d)))])
-    e1 /= np.linalg.norm(e1)
+    e1 = _perpendicular(d)
     return centre, float(sph.Radius()), e1, np.cross(d, e1), d
 
 
@@ -350,12 +358,8 @@ def _sphere_row(chain, step: float, sphere) -> np.ndarray:
         np.array((last.startPoint() if rev1 else last.endPoint()).toTuple()),
     ]
     lengths = np.array([e.Length() for e, _ in chain])
-    half = lengths.sum() / 2
-    j = int(np.searchsorted(np.cumsum(lengths), half))
-    j = min(j, len(chain) - 1)
-    e, rev = chain[j]
-    frac = (half - (lengths[:j].sum())) / lengths[j]
-    mid = np.array(e.positionAt(1.0 - frac if rev else frac, mode="length").toTuple())
+    starts = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
+    mid = _chain_point(chain, lengths, starts, float(lengths.sum()) / 2)
     cc = centre + float((ends[0] - centre) @ d) * d
     r = float(np.linalg.norm(ends[0] - cc))
     if r < 1e-12:
@@ -418,8 +422,8 @@ def _columns(face, d, hf, ratio, anchor, axis_steps):
             t = np.array(e.endPoint().toTuple()) - np.array(e.startPoint().toTuple())
             if abs(abs(float(t @ rows)) - np.linalg.norm(t)) <= 1e-9 * np.linalg.norm(t):
                 return None
-    k = int(np.argmax(np.abs(rows)))
-    if abs(abs(rows[k]) - 1.0) < 1e-12:
+    k = _axis_index(rows)
+    if k is not None:
         axis = np.zeros(3)
         axis[k] = 1.0
         return axis, float(anchor[k]), float(axis_steps[k])
