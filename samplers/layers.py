@@ -333,7 +333,9 @@ def _clamp_lines(lines: list[_Line], h: float):
     return clamp
 
 
-def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -> list[dict]:
+def repair_planar_faces(
+    occ, s: Samples, h: float, size: float, row_dirs=None, skip=frozenset()
+) -> list[dict]:
     """Repair the boundary layer of every planar face bounded by circular arcs
     or by straight sharp edges slanted to its scan rows.
 
@@ -342,8 +344,9 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -
     samples on straight edges stay.  ``row_dirs`` (per face, the normal of
     its scan planes) tells which straight edges are slanted; without it only
     arcs are repaired.  Faces are taken in order, each seeing the samples of
-    the ones before it as they were left.  Returns one report per repaired
-    face.
+    the ones before it as they were left; faces in ``skip`` (laid out
+    already, :func:`samplers.disks.lattice_disk_faces`) are left alone.
+    Returns one report per repaired face.
     """
     reports = []
     done: dict[tuple, object] = {}
@@ -352,7 +355,7 @@ def repair_planar_faces(occ, s: Samples, h: float, size: float, row_dirs=None) -
     nbrs = adjacency.across()
     faces = adjacency.faces
     for fi, face in enumerate(faces):
-        if face.geomType() != "PLANE":
+        if face.geomType() != "PLANE" or fi in skip:
             continue
         o, u, v, n = _plane_frame(face)
 

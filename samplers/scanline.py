@@ -30,8 +30,11 @@ a CadQuery shape:
 * where the rows leave a gap (planes grazing a face: the poles of a sphere),
   extra samples are projected onto the surface until every point of it is
   within h of a sample (their ``line_id`` is -2);
-* where rows meet a circular sharp edge (a hole, a disk's rim, the cut of
-  a scoop) the boundary layer of each planar face is repaired until its
+* planar disks and annuli whose rims bound cones or cylinders are laid
+  out in rings about their centre, halving their columns inwards
+  (:mod:`samplers.disks`);
+* where rows meet a circular sharp edge (a hole, the cut of a scoop) the
+  boundary layer of each other planar face is repaired until its
   Delaunay triangles meet Condition III-ii (:mod:`samplers.layers`,
   :mod:`samplers.repair`); full cylinders are then laid out as the lattice
   their two rims span, and cones with a sampled rim in rings that keep the
@@ -658,8 +661,9 @@ def scan(
         Edges whose faces' normals differ by more than this are sampled
         explicitly (as are boundary edges and corners).
     repair : bool
-        Repair the boundary layers where rows meet circular edges
-        (:mod:`samplers.layers`), so that Condition III-ii holds there too.
+        Lay disks out in rings and repair the boundary layers where rows
+        meet circular edges (:mod:`samplers.disks`, :mod:`samplers.layers`),
+        so that Condition III-ii holds there too.
 
     Returns
     -------
@@ -756,6 +760,7 @@ def scan(
         on_feature = np.r_[on_feature, np.zeros(fill.shape[0], dtype=bool)]
     reports: list[dict] = []
     if repair:
+        from .disks import lattice_disk_faces
         from .layers import (
             Samples,
             lattice_cone_faces,
@@ -765,7 +770,10 @@ def scan(
         )
 
         bag = Samples(points, line_id, face_id, on_feature)
-        reports = repair_planar_faces(occ, bag, h, size, row_dirs=[dirs[f] for f in fam])
+        reports, rings = lattice_disk_faces(occ, bag, h, size)
+        reports += repair_planar_faces(
+            occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=rings
+        )
         reports += lattice_cylinder_faces(occ, bag, h, size)
         reports += lattice_cone_faces(occ, bag, h, size)
         reports += lattice_revolved_body(occ, bag, h, size)

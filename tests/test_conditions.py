@@ -97,3 +97,37 @@ def test_conditions_command(plane, tmp_path, capsys):
     out = capsys.readouterr().out
     assert "III-i  DT_M degree <= 33" in out and "pass" in out
     assert "II-ii  geodesic distortion epsilon" in out
+
+
+def test_dt_m_of_a_flat_annulus_with_a_cad_truth_is_its_delaunay():
+    """A CAD tessellation of an annulus (one strip of long thin triangles from
+    the inner to the outer circle) distorts distances along mesh edges by a
+    direction-dependent factor; labelled by edge paths alone, the geodesic
+    Voronoi diagram gave false DT_M triangles here (123 samples "violating",
+    worst ratio 0.958).  On a flat face DT_M is the planar Delaunay
+    triangulation: the check must give each sample its planar worst ratio
+    (up to the choice of diagonal in a near-cocircular cell)."""
+    from scipy.spatial import Delaunay
+
+    from samplers.disks import _layout
+
+    m, r_in, r_out, h = 126, 0.3, 0.5, 0.02
+    a = 2 * np.pi * np.arange(m) / m
+    ring = np.stack([np.cos(a), np.sin(a), np.zeros(m)], axis=1)
+    tv = np.vstack([r_in * ring, r_out * ring])
+    i = np.arange(m)
+    j = (i + 1) % m
+    tf = np.vstack([np.stack([i, j, m + j], 1), np.stack([i, m + j, m + i], 1)])
+    uv = _layout((r_out, r_in), h)[0]
+    p = np.c_[uv, np.zeros(len(uv))]
+    rep = sample_conditions(p, tv, tf)
+    tri = Delaunay(uv).simplices
+    tri = tri[np.linalg.norm(uv[tri].mean(axis=1), axis=1) > r_in]  # not across the hole
+    side = np.sort(np.linalg.norm(uv[tri] - uv[np.roll(tri, 1, axis=1)], axis=2), axis=1)
+    ratio = side[:, 1] / side[:, 2]
+    planar = np.zeros(len(uv))
+    for col in range(3):
+        np.maximum.at(planar, tri[:, col], ratio)
+    # (cells that are near-cocircular quads may take either diagonal)
+    np.testing.assert_allclose(rep.worst_ratio, planar, atol=0.05)
+    assert np.count_nonzero(~(rep.worst_ratio < np.sqrt(3) / 2)) == 0

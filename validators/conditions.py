@@ -224,6 +224,99 @@ def _geodesic_lengths(pts, edges, tv, tf, vertex_of) -> np.ndarray:
     return length
 
 
+def _patch_sets(tv: np.ndarray, tf: np.ndarray, degrees: float) -> np.ndarray:
+    """Per truth vertex, the smooth patches it lies on, padded with -1 (m, K).
+
+    A patch is a set of triangles joined across edges whose dihedral is
+    below ``degrees``; a vertex on a sharp edge lies on every patch round it.
+    """
+    from scipy import sparse
+    from scipy.sparse import csgraph
+
+    nt = tf.shape[0]
+    nrm = np.cross(tv[tf[:, 1]] - tv[tf[:, 0]], tv[tf[:, 2]] - tv[tf[:, 0]])
+    nrm /= np.maximum(np.linalg.norm(nrm, axis=1), 1e-300)[:, None]
+    e = np.sort(np.concatenate([tf[:, [0, 1]], tf[:, [1, 2]], tf[:, [2, 0]]]), axis=1)
+    face = np.tile(np.arange(nt), 3)
+    key = e[:, 0] * tv.shape[0] + e[:, 1]
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    same = np.flatnonzero(ks[1:] == ks[:-1])
+    fa, fb = face[order[same]], face[order[same + 1]]
+    smooth = (nrm[fa] * nrm[fb]).sum(axis=1) >= np.cos(np.radians(degrees))
+    adj = sparse.coo_matrix((np.ones(int(smooth.sum())), (fa[smooth], fb[smooth])), shape=(nt, nt))
+    _, patch = csgraph.connected_components(adj, directed=False)
+    pairs = np.unique(np.stack([tf.ravel(), np.repeat(patch, 3)], axis=1), axis=0)
+    counts = np.bincount(pairs[:, 0], minlength=tv.shape[0])
+    width = max(1, int(counts.max()))
+    out = np.full((tv.shape[0], width), -1, dtype=np.int64)
+    start = np.cumsum(counts) - counts
+    out[pairs[:, 0], np.arange(pairs.shape[0]) - start[pairs[:, 0]]] = pairs[:, 1]
+    return out
+
+
+def _share(pa: np.ndarray, pb: np.ndarray) -> np.ndarray:
+    """Row-wise: whether two rows of :func:`_patch_sets` have a patch in common."""
+    eq = (pa[:, :, None] == pb[:, None, :]) & (pa[:, :, None] >= 0)
+    return eq.any(axis=(1, 2))
+
+
+def _nearest_sample(tv, e, w, snap, pts, patches, max_sweeps: int = 500):
+    """Label every truth vertex with its geodesically nearest sample.
+
+    Multi-source Dijkstra over the mesh edges gives a first label, but edge
+    paths overestimate distances by a direction-dependent factor (most on
+    the long thin triangles of a CAD tessellation of a flat face), which
+    moves the Voronoi boundaries and makes false DT_M triangles.  The labels
+    are then corrected by sweeps: a vertex takes a neighbour's sample when
+    that is nearer, the distance to a sample on a smooth patch the vertex
+    shares being the straight chord (exact on a flat face, within
+    ``(L / R)^2 / 24`` on a curved one), and otherwise the neighbour's
+    distance plus the edge.  Ties go to the lower sample index.
+    """
+    from scipy import sparse
+    from scipy.sparse import csgraph
+
+    m = tv.shape[0]
+    g = sparse.csr_matrix((np.r_[w, w], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), (m, m))
+    dist, _, src = csgraph.dijkstra(g, indices=snap, min_only=True, return_predecessors=True)
+    sample_of = np.full(m, -1, dtype=np.int64)
+    sample_of[snap] = np.arange(snap.size)
+    label = np.where(src >= 0, sample_of[np.maximum(src, 0)], -1)
+    ok = label >= 0
+    score = dist.copy()
+    chord = np.linalg.norm(tv[ok] - pts[label[ok]], axis=1)
+    shared = _share(patches[ok], patches[snap[label[ok]]])
+    score[ok] = np.where(shared, chord, dist[ok])
+    a = np.r_[e[:, 0], e[:, 1]]
+    b = np.r_[e[:, 1], e[:, 0]]
+    ww = np.r_[w, w]
+    active = np.ones(m, dtype=bool)
+    for _ in range(max_sweeps):
+        sel = np.flatnonzero(active[b] & (label[b] >= 0) & (label[b] != label[a]))
+        if sel.size == 0:
+            break
+        va, vb, cand = a[sel], b[sel], label[b[sel]]
+        direct = np.linalg.norm(tv[va] - pts[cand], axis=1)
+        via = score[vb] + ww[sel]
+        s = np.where(_share(patches[va], patches[snap[cand]]), direct, via)
+        better = s < score[va] - 1e-12 * np.maximum(s, 1e-300)
+        tie = (np.abs(s - score[va]) <= 1e-12 * np.maximum(s, 1e-300)) & (cand < label[va])
+        take = better | tie
+        if not take.any():
+            break
+        va, cand, s = va[take], cand[take], s[take]
+        # per vertex the best offer (lowest distance, then lowest sample)
+        order = np.lexsort((cand, s, va))
+        first = np.r_[True, va[order][1:] != va[order][:-1]]
+        pick = order[first]
+        active[:] = False
+        active[va[pick]] = True
+        label[va[pick]] = cand[pick]
+        score[va[pick]] = s[pick]
+    return label
+
+
 def sample_conditions(
     points,
     truth_vertices,
@@ -236,9 +329,11 @@ def sample_conditions(
 
     DT_M is the dual of the geodesic Voronoi diagram of the samples on the
     ground-truth mesh: each truth vertex is labelled with its nearest sample
-    by multi-source Dijkstra over the mesh edges (scipy.sparse.csgraph), a
-    truth edge between two labels gives a DT_M edge and a truth triangle with
-    three labels a DT_M triangle.  Geodesic lengths of DT_M edges are exact
+    (multi-source Dijkstra over the mesh edges, scipy.sparse.csgraph, then
+    corrected with straight chords on the smooth patches a vertex shares
+    with a sample, :func:`_nearest_sample`), a truth edge between two labels
+    gives a DT_M edge and a truth triangle with three labels a DT_M
+    triangle.  Geodesic lengths of DT_M edges are exact
     mesh geodesics (potpourri3d's edge-flip solver) between the samples.
     Before that the truth is refined (:func:`validators.refine.refine_to_edge_length`)
     until no edge is longer than ``resolution``, and every sample is made a
@@ -260,8 +355,6 @@ def sample_conditions(
     -------
     ConditionReport
     """
-    from scipy import sparse
-    from scipy.sparse import csgraph
 
     from .fidelity import sharp_edges
     from .refine import insert_points, refine_to_edge_length
@@ -280,13 +373,7 @@ def sample_conditions(
     e = np.concatenate([tf[:, [0, 1]], tf[:, [1, 2]], tf[:, [2, 0]]])
     e = np.unique(np.sort(e, axis=1), axis=0)
     w = np.linalg.norm(tv[e[:, 0]] - tv[e[:, 1]], axis=1)
-    m = tv.shape[0]
-    g = sparse.csr_matrix((np.r_[w, w], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), (m, m))
-    _, _, src = csgraph.dijkstra(g, indices=snap, min_only=True, return_predecessors=True)
-    label_of_vertex = np.full(m, -1, dtype=np.int64)
-    sample_of = {int(v): i for i, v in enumerate(snap)}
-    ok = src >= 0
-    label_of_vertex[ok] = [sample_of[int(s)] for s in src[ok]]
+    label_of_vertex = _nearest_sample(tv, e, w, snap, pts, _patch_sets(tv, tf, sharp_degrees))
     la, lb = label_of_vertex[e[:, 0]], label_of_vertex[e[:, 1]]
     diff = (la != lb) & (la >= 0) & (lb >= 0)
     dt_edges = np.unique(np.sort(np.stack([la[diff], lb[diff]], axis=1), axis=1), axis=0)
