@@ -203,8 +203,19 @@ def _ring_points(t: float, rings, disk: bool) -> tuple[np.ndarray, np.ndarray, n
     return np.vstack(uv), np.concatenate(ring), np.concatenate(near)
 
 
-def _layout(radii: tuple[float, ...], h: float):
-    """The repaired ring samples of a face of these radii (2-D), and which are rims."""
+@dataclass(frozen=True)
+class _Layout:
+    """A face's ring samples in 2-D about its centre, after the repair."""
+
+    uv: np.ndarray
+    rim: np.ndarray  # on a rim (a feature sample)
+    ring: np.ndarray  # ring index (0 the outer rim); -1 the centre or a sample the repair added
+    bad: int
+    worst: float
+
+
+def _layout(radii: tuple[float, ...], h: float) -> _Layout:
+    """The repaired ring samples of a face of these radii."""
     t, rings = ring_plan(radii, h)
     disk = len(radii) == 1
     uv, ring, near = _ring_points(t, rings, disk)
@@ -223,12 +234,12 @@ def _layout(radii: tuple[float, ...], h: float):
         return (r < radii[0]) & (r > (radii[1] if len(radii) > 1 else -1.0))
 
     if not free.any():
-        return uv, rim, ring, 0, 0.0
+        return _Layout(uv, rim, ring, 0, 0.0)
     out = repair(uv, free, t, inside=inside, clamp=clamp)
     keep = out.origin
     rim_out = np.where(keep >= 0, rim[np.maximum(keep, 0)], False)
     ring_out = np.where(keep >= 0, ring[np.maximum(keep, 0)], -1)
-    return out.uv, rim_out, ring_out, out.bad, out.worst
+    return _Layout(out.uv, rim_out, ring_out, int(out.bad), float(out.worst))
 
 
 def _edge_index(adjacency: EdgeFaces, edge) -> int:
@@ -247,13 +258,14 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
     adjacency = EdgeFaces(occ)
     reports: list[dict] = []
     done: set[int] = set()
-    cache: dict[tuple, tuple] = {}
+    cache: dict[tuple, _Layout] = {}
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     for rf in round_faces(adjacency, tol):
         key = tuple(round(r / h, 9) for r in rf.radii)
         if key not in cache:
             cache[key] = _layout(rf.radii, h)
-        uv, rim, ring, bad, worst = cache[key]
+        lay = cache[key]
+        uv, rim, ring = lay.uv, lay.rim, lay.ring
         ex = _perpendicular(rf.normal)
         ey = np.cross(rf.normal, ex)
         q = s.points - rf.centre
@@ -281,8 +293,8 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
                 "kind": "disk rings" if len(rf.radii) == 1 else "annulus rings",
                 "rings": int(ring.max()) + 1,
                 "samples": int(uv.shape[0]),
-                "bad": int(bad),
-                "worst": float(worst),
+                "bad": lay.bad,
+                "worst": lay.worst,
             }
         )
     return reports, done

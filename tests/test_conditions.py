@@ -118,7 +118,7 @@ def test_dt_m_of_a_flat_annulus_with_a_cad_truth_is_its_delaunay():
     i = np.arange(m)
     j = (i + 1) % m
     tf = np.vstack([np.stack([i, j, m + j], 1), np.stack([i, m + j, m + i], 1)])
-    uv = _layout((r_out, r_in), h)[0]
+    uv = _layout((r_out, r_in), h).uv
     p = np.c_[uv, np.zeros(len(uv))]
     rep = sample_conditions(p, tv, tf)
     tri = Delaunay(uv).simplices

@@ -233,17 +233,11 @@ def _patch_sets(tv: np.ndarray, tf: np.ndarray, degrees: float) -> np.ndarray:
     from scipy import sparse
     from scipy.sparse import csgraph
 
+    from .fidelity import dihedral_pairs
+
     nt = tf.shape[0]
-    nrm = np.cross(tv[tf[:, 1]] - tv[tf[:, 0]], tv[tf[:, 2]] - tv[tf[:, 0]])
-    nrm /= np.maximum(np.linalg.norm(nrm, axis=1), 1e-300)[:, None]
-    e = np.sort(np.concatenate([tf[:, [0, 1]], tf[:, [1, 2]], tf[:, [2, 0]]]), axis=1)
-    face = np.tile(np.arange(nt), 3)
-    key = e[:, 0] * tv.shape[0] + e[:, 1]
-    order = np.argsort(key, kind="stable")
-    ks = key[order]
-    same = np.flatnonzero(ks[1:] == ks[:-1])
-    fa, fb = face[order[same]], face[order[same + 1]]
-    smooth = (nrm[fa] * nrm[fb]).sum(axis=1) >= np.cos(np.radians(degrees))
+    _, fa, fb, cos = dihedral_pairs(tv, tf)
+    smooth = cos >= np.cos(np.radians(degrees))
     adj = sparse.coo_matrix((np.ones(int(smooth.sum())), (fa[smooth], fb[smooth])), shape=(nt, nt))
     _, patch = csgraph.connected_components(adj, directed=False)
     pairs = np.unique(np.stack([tf.ravel(), np.repeat(patch, 3)], axis=1), axis=0)

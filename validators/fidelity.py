@@ -124,8 +124,9 @@ def hausdorff(
     )
 
 
-def sharp_edges(vertices, triangles, degrees: float = 30.0) -> np.ndarray:
-    """Edges (sorted pairs) whose two triangles' normals differ by more than ``degrees``."""
+def dihedral_pairs(vertices, triangles) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Every edge two triangles share: the edge (sorted pair), the two
+    triangles, and the cosine between their unit normals."""
     v = np.asarray(vertices, dtype=np.float64)
     t = np.asarray(triangles, dtype=np.int64)
     n = np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]])
@@ -138,9 +139,13 @@ def sharp_edges(vertices, triangles, degrees: float = 30.0) -> np.ndarray:
     ks = key[order]
     same = np.flatnonzero(ks[1:] == ks[:-1])
     fa, fb = face[order[same]], face[order[same + 1]]
-    cos = (n[fa] * n[fb]).sum(axis=1)
-    sharp = same[cos < np.cos(np.radians(degrees))]
-    return np.unique(e[order[sharp]], axis=0)
+    return e[order[same]], fa, fb, (n[fa] * n[fb]).sum(axis=1)
+
+
+def sharp_edges(vertices, triangles, degrees: float = 30.0) -> np.ndarray:
+    """Edges (sorted pairs) whose two triangles' normals differ by more than ``degrees``."""
+    e, _, _, cos = dihedral_pairs(vertices, triangles)
+    return np.unique(e[cos < np.cos(np.radians(degrees))], axis=0).reshape(-1, 2)
 
 
 def feature_distance(
