@@ -49,6 +49,10 @@ class EdgeFaces:
             self.faces_of.append(uniq)
             self.uses.append(len(adj))
 
+    def index(self, edge) -> int:
+        """Position of ``edge`` in :attr:`edges` (-1 if it bounds no face)."""
+        return self._map.FindIndex(edge.wrapped) - 1
+
     def across(self) -> list[list[tuple[object, int]]]:
         """Per face, each of its edges (in the face's order) and the lowest
         index of another face bounded by it (-1: none, a boundary or a seam)."""
@@ -56,8 +60,8 @@ class EdgeFaces:
         for fi, face in enumerate(self.faces):
             row = []
             for e in face.Edges():
-                k = self._map.FindIndex(e.wrapped)
-                others = [j for j in self.faces_of[k - 1] if j != fi] if k > 0 else []
+                k = self.index(e)
+                others = [j for j in self.faces_of[k] if j != fi] if k >= 0 else []
                 row.append((e, min(others) if others else -1))
             out.append(row)
         return out

@@ -34,11 +34,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .adjacency import EdgeFaces
-from .layers import Samples, _goes_round, _halving_count, _perpendicular
-from .repair import repair
+from .layers import Samples, _goes_round, _halving_count, _perpendicular, _radial_clamp
+from .repair import MOVABLE, repair
 
 HALVE_GAP = 0.75  # a ring halves its columns rather than let gaps fall below this (times t)
-MOVABLE = 3.0  # samples this near (times t) a ring that halves, or the centre, may move
 
 
 @dataclass(frozen=True)
@@ -99,29 +98,35 @@ def round_faces(adjacency: EdgeFaces, tol: float) -> list[RoundFace]:
     columns, :func:`samplers.layers.lattice_cylinder_faces`).
     """
     faces = adjacency.faces
-    across = adjacency.across()
     found = {fi: r for fi, f in enumerate(faces) if (r := _as_round(fi, f, tol)) is not None}
     changed = True
     while changed:
         changed = False
         for fi in sorted(found):
-            if not all(_rim_ok(fi, e, faces, across, found) for e in found[fi].edges):
+            if not all(_rim_ok(fi, e, adjacency, found) for e in found[fi].edges):
                 del found[fi]
                 changed = True
     return [found[fi] for fi in sorted(found)]
 
 
-def _rim_ok(fi: int, edge, faces, across, found) -> bool:
-    other = next((k for e, k in across[fi] if e.isSame(edge)), -1)
+def _across(adjacency: EdgeFaces, edge, fi: int) -> int:
+    """The lowest index of a face other than ``fi`` bounded by ``edge`` (-1: none)."""
+    others = [k for k in adjacency.faces_of[adjacency.index(edge)] if k != fi]
+    return min(others) if others else -1
+
+
+def _rim_ok(fi: int, edge, adjacency: EdgeFaces, found) -> bool:
+    other = _across(adjacency, edge, fi)
     if other < 0:
         return True
-    face = faces[other]
+    face = adjacency.faces[other]
     if face.geomType() == "CONE":
         return _goes_round(face)
     if face.geomType() != "CYLINDER" or not _goes_round(face):
         return False
-    for e, k in across[other]:
+    for e in face.Edges():
         if e.geomType() == "CIRCLE" and not e.isSame(edge):
+            k = _across(adjacency, e, other)
             return k in found and k != fi
     return False
 
@@ -222,12 +227,7 @@ def _layout(radii: tuple[float, ...], h: float) -> _Layout:
     rim = (ring == 0) | ((ring == len(rings) - 1) & (not disk))
     free = near & ~rim
     lo = radii[1] + 0.25 * t if len(radii) > 1 else 0.0
-    hi = radii[0] - 0.25 * t
-
-    def clamp(p: np.ndarray) -> np.ndarray:
-        r = np.linalg.norm(p, axis=1)
-        s = np.clip(r, lo, hi) / np.maximum(r, 1e-300)
-        return np.where((r > 0)[:, None], p * s[:, None], p)
+    clamp = _radial_clamp(lo, radii[0] - 0.25 * t)
 
     def inside(c: np.ndarray) -> np.ndarray:
         r = np.linalg.norm(c, axis=1)
@@ -240,10 +240,6 @@ def _layout(radii: tuple[float, ...], h: float) -> _Layout:
     rim_out = np.where(keep >= 0, rim[np.maximum(keep, 0)], False)
     ring_out = np.where(keep >= 0, ring[np.maximum(keep, 0)], -1)
     return _Layout(out.uv, rim_out, ring_out, int(out.bad), float(out.worst))
-
-
-def _edge_index(adjacency: EdgeFaces, edge) -> int:
-    return next(k for k, e in enumerate(adjacency.edges) if e.isSame(edge))
 
 
 def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dict], set[int]]:
@@ -275,7 +271,7 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
         mine = (np.abs(off) < tol) & (radial < rf.radii[0] + tol) & (radial > lo - tol)
         idx = np.flatnonzero(mine)
         # a rim sample belongs to its edge's first face, as in the scan
-        first = [adjacency.faces_of[_edge_index(adjacency, e)][0] for e in rf.edges]
+        first = [adjacency.faces_of[adjacency.index(e)][0] for e in rf.edges]
         rim_face = np.where(ring == 0, first[0], first[-1])
         pts3 = rf.centre + uv[:, :1] * ex + uv[:, 1:] * ey
         s.replace(

@@ -28,7 +28,7 @@ import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
 from .adjacency import EdgeFaces
-from .repair import repair
+from .repair import MOVABLE, repair
 
 LAYER = 2.5  # samples within this many h of a circular edge may move
 RASTER = 8  # inside tests on a grid of h / RASTER
@@ -223,6 +223,17 @@ def _clamp(arcs: list[_Arc], sides: list[float], h: float):
                 target = a.radius - side * 0.25 * h
                 out[bad] = a.centre + w[bad] / r[bad, None] * target
         return out
+
+    return clamp
+
+
+def _radial_clamp(lo: float, hi: float):
+    """Keep points at a distance from the origin within [lo, hi] (the origin stays)."""
+
+    def clamp(p: np.ndarray) -> np.ndarray:
+        r = np.linalg.norm(p, axis=1)
+        s = np.clip(r, lo, hi) / np.maximum(r, 1e-300)
+        return np.where((r > 0)[:, None], p * s[:, None], p)
 
     return clamp
 
@@ -655,8 +666,6 @@ def _repair_developed(rho, ang, row, rim_ang, slant: float, sin_a: float, t: flo
     Returns the new (rho, ang, row; -1 for an added sample), the triangles
     left above the repair's margin and the worst ratio.
     """
-    from .disks import MOVABLE
-
     theta = 2 * math.pi * sin_a
     psi = ang * sin_a
     uv = np.stack([rho * np.cos(psi), rho * np.sin(psi)], axis=1)
@@ -678,10 +687,6 @@ def _repair_developed(rho, ang, row, rim_ang, slant: float, sin_a: float, t: flo
         a = np.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
         return (r < slant) & (a > 0) & (a < theta)
 
-    def clamp(p: np.ndarray) -> np.ndarray:
-        r = np.linalg.norm(p, axis=1)
-        return p * (np.minimum(r, slant - 0.25 * t) / np.maximum(r, 1e-300))[:, None]
-
     n = uv.shape[0]
     frame = np.vstack(frame)
     # where the rings break Condition III-ii: the triangles to mend
@@ -700,7 +705,9 @@ def _repair_developed(rho, ang, row, rim_ang, slant: float, sin_a: float, t: flo
         return rho, ang, row, 0, 0.0
     fixed_free = np.r_[free, np.zeros(rim.shape[0] + 1, dtype=bool)]
 
-    out = repair(allp, fixed_free, t, inside=inside, clamp=clamp, frame=frame)
+    out = repair(
+        allp, fixed_free, t, inside=inside, clamp=_radial_clamp(0.0, slant - 0.25 * t), frame=frame
+    )
     mine = out.origin < n  # not the rim nor the apex
     uv2 = out.uv[mine]
     origin = out.origin[mine]

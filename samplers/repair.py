@@ -39,6 +39,7 @@ WIDE = 1.0  # circumradii larger than this (times h) are penalised
 GAP = (0.75, 1.35)  # spacing kept between neighbours sliding along one edge, times h
 STEP = 0.02  # largest move per descent step, times h
 SEPARATION = 12.0  # bad triangles edited at once are this far apart, times h
+MOVABLE = 3.0  # a layout's samples this near (times h) a defect it repairs may move
 REACH = 4.0  # in a local descent, triangles with a longer edge (times h) join two regions
 _EDGES = np.array([[0, 1], [1, 2], [2, 0]])
 
