@@ -35,6 +35,7 @@ RASTER = 8  # inside tests on a grid of h / RASTER
 END_GAP = 0.8  # a ring's column ends where its gap falls below this (times the row step)
 END_MERGED = 1.65  # ... unless the merged gap would exceed this
 NARROW = 0.6  # ... or it ends anyway once a gap is below this (times the row step)
+ARC_MARGIN = 0.5  # free samples keep this far (times h) from a cylinder's rim (else h / 4)
 LINE_EDITS = 0  # edits on a face with slanted straight edges only
 SQRT3_2 = math.sqrt(3.0) / 2.0  # Condition III-ii's bound on a triangle's edge ratio
 
@@ -218,9 +219,10 @@ def _clamp(arcs: list[_Arc], sides: list[float], h: float):
             ang = (np.arctan2(w[:, 1], w[:, 0]) - a.start) % (2 * math.pi)
             within = a.closed | (ang <= a.span)
             inward = side * (a.radius - r)  # distance into the face from the arc
-            bad = within & (inward < 0.25 * h) & (r > 1e-12)
+            margin = (ARC_MARGIN if a.slides else 0.25) * h
+            bad = within & (inward < margin) & (r > 1e-12)
             if bad.any():
-                target = a.radius - side * 0.25 * h
+                target = a.radius - side * margin
                 out[bad] = a.centre + w[bad] / r[bad, None] * target
         return out
 

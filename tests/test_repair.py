@@ -97,3 +97,22 @@ def test_halving_counts_are_three_four_or_five_times_a_power_of_two():
 
     got = [_halving_count(x) for x in (1, 3, 4.4, 5.6, 7, 9, 11, 14, 25, 50, 100, 125, 170)]
     assert got == [3, 3, 4, 6, 8, 10, 12, 16, 24, 48, 96, 128, 160]
+
+
+def test_free_samples_keep_half_h_from_a_cylinders_rim():
+    """A free sample nearer a sliding rim than h / 2 (block_two_holes: one at
+    0.33 h made a Delaunay triangle with the wall's first row across the rim,
+    ratio 0.99) is put back at h / 2; other arcs keep h / 4."""
+    import math
+
+    from samplers.layers import _Arc, _clamp
+
+    h = 0.1
+    rim = _Arc(np.zeros(2), 1.0, 0.0, 2 * math.pi, True, True)
+    other = _Arc(np.array([5.0, 0.0]), 1.0, 0.0, 2 * math.pi, True, False)
+    clamp = _clamp([rim, other], [-1.0, -1.0], h)  # the face lies outside both circles
+    p = np.array([[1.03, 0.0], [0.0, 1.2], [6.02, 0.0], [5.0, 1.3]])
+    out = clamp(p)
+    r = np.linalg.norm(out - [[0, 0], [0, 0], [5, 0], [5, 0]], axis=1)
+    np.testing.assert_allclose(r, [1.05, 1.2, 1.025, 1.3])
+    np.testing.assert_allclose(out[:, 1], p[:, 1])  # moved along the radius
