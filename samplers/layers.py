@@ -36,7 +36,7 @@ END_GAP = 0.8  # a ring's column ends where its gap falls below this (times the 
 END_MERGED = 1.65  # ... unless the merged gap would exceed this
 NARROW = 0.6  # ... or it ends anyway once a gap is below this (times the row step)
 ARC_MARGIN = 0.5  # free samples keep this far (times h) from a cylinder's rim (else h / 4)
-LINE_EDITS = 0  # edits on a face with slanted straight edges only
+LINE_EDITS = 40  # edits on a face with slanted straight edges only
 SQRT3_2 = math.sqrt(3.0) / 2.0  # Condition III-ii's bound on a triangle's edge ratio
 
 
