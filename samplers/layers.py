@@ -209,7 +209,10 @@ def _arc_sides(arcs: list[_Arc], raster: _Raster, h: float) -> list[float]:
 
 
 def _clamp(arcs: list[_Arc], sides: list[float], h: float):
-    """Keep free samples on the face side of every arc, at least h / 4 from it."""
+    """Keep free samples on the face side of every arc, at least ``ARC_MARGIN`` h
+    from a full cylinder's rim (nearer, a sample makes a Delaunay triangle with
+    the wall's first row across the rim, which the repair does not judge) and
+    h / 4 from other arcs."""
 
     def clamp(p: np.ndarray) -> np.ndarray:
         out = p.copy()
