@@ -53,15 +53,16 @@ class EdgeFaces:
         """Position of ``edge`` in :attr:`edges` (-1 if it bounds no face)."""
         return self._map.FindIndex(edge.wrapped) - 1
 
+    def other(self, edge, fi: int) -> int:
+        """The lowest index of a face other than ``fi`` bounded by ``edge``
+        (-1: none, a boundary, a seam, or an edge of no face)."""
+        k = self.index(edge)
+        others = [j for j in self.faces_of[k] if j != fi] if k >= 0 else []
+        return min(others) if others else -1
+
     def across(self) -> list[list[tuple[object, int]]]:
         """Per face, each of its edges (in the face's order) and the lowest
         index of another face bounded by it (-1: none, a boundary or a seam)."""
-        out = []
-        for fi, face in enumerate(self.faces):
-            row = []
-            for e in face.Edges():
-                k = self.index(e)
-                others = [j for j in self.faces_of[k] if j != fi] if k >= 0 else []
-                row.append((e, min(others) if others else -1))
-            out.append(row)
-        return out
+        return [
+            [(e, self.other(e, fi)) for e in face.Edges()] for fi, face in enumerate(self.faces)
+        ]

@@ -109,14 +109,8 @@ def round_faces(adjacency: EdgeFaces, tol: float) -> list[RoundFace]:
     return [found[fi] for fi in sorted(found)]
 
 
-def _across(adjacency: EdgeFaces, edge, fi: int) -> int:
-    """The lowest index of a face other than ``fi`` bounded by ``edge`` (-1: none)."""
-    others = [k for k in adjacency.faces_of[adjacency.index(edge)] if k != fi]
-    return min(others) if others else -1
-
-
 def _rim_ok(fi: int, edge, adjacency: EdgeFaces, found) -> bool:
-    other = _across(adjacency, edge, fi)
+    other = adjacency.other(edge, fi)
     if other < 0:
         return True
     face = adjacency.faces[other]
@@ -126,7 +120,7 @@ def _rim_ok(fi: int, edge, adjacency: EdgeFaces, found) -> bool:
         return False
     for e in face.Edges():
         if e.geomType() == "CIRCLE" and not e.isSame(edge):
-            k = _across(adjacency, e, other)
+            k = adjacency.other(e, other)
             return k in found and k != fi
     return False
 

@@ -27,6 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
+from validators.conditions import SQRT3_2
+
 from .adjacency import EdgeFaces
 from .repair import MOVABLE, repair
 
@@ -37,7 +39,6 @@ END_MERGED = 1.65  # ... unless the merged gap would exceed this
 NARROW = 0.6  # ... or it ends anyway once a gap is below this (times the row step)
 ARC_MARGIN = 0.5  # free samples keep this far (times h) from a cylinder's rim (else h / 4)
 LINE_EDITS = 40  # edits on a face with slanted straight edges only
-SQRT3_2 = math.sqrt(3.0) / 2.0  # Condition III-ii's bound on a triangle's edge ratio
 
 
 @dataclass
