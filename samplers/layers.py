@@ -156,16 +156,19 @@ def _arcs(face, to2d, across=()) -> list[_Arc]:
     return out
 
 
-def _nearest_arc(arcs: list[_Arc], p: np.ndarray) -> np.ndarray:
-    """Index of the arc nearest to each point."""
+def _nearest_arc(arcs: list, p: np.ndarray) -> np.ndarray:
+    """Index of the curve (arc or line) nearest to each point."""
     return np.argmin(np.stack([a.distance(p) for a in arcs], axis=1), axis=1)
 
 
-def _project_onto(arcs: list[_Arc], margin: float):
+def _project_onto(curves: list, margin: float):
+    """Map each point to the nearest point of its nearest curve (arcs and
+    lines), at least ``margin`` from the curve's ends."""
+
     def project(p: np.ndarray) -> np.ndarray:
-        which = _nearest_arc(arcs, p)
+        which = _nearest_arc(curves, p)
         out = p.copy()
-        for k, a in enumerate(arcs):
+        for k, a in enumerate(curves):
             sel = which == k
             if sel.any():
                 out[sel] = a.project(p[sel], margin)
@@ -184,6 +187,8 @@ def _ghosts(arcs: list[_Arc], sides: list[float], h: float):
     """
 
     def ghosts(p: np.ndarray) -> np.ndarray:
+        # the sliding samples on an arc (those on a straight edge have the frame)
+        p = p[np.min(np.stack([a.distance(p) for a in arcs], axis=1), axis=1) < 1e-6 * h]
         if p.shape[0] == 0:
             return np.empty((0, 2))
         which = _nearest_arc(arcs, p)
@@ -273,6 +278,7 @@ class _Line:
     b: np.ndarray
     inward: np.ndarray  # 2-D unit normal pointing into the face
     frame: np.ndarray  # the neighbouring face's samples near the edge, unfolded (2-D)
+    slides: bool  # slanted to the neighbouring face's rows too: its samples slide
 
     def along(self, p: np.ndarray) -> np.ndarray:
         """The edge parameter of each point's foot (0 at ``a``, 1 at ``b``)."""
@@ -283,18 +289,33 @@ class _Line:
         t = np.clip(self.along(p), 0.0, 1.0)
         return np.linalg.norm(p - (self.a + t[:, None] * (self.b - self.a)), axis=1)
 
+    def project(self, p: np.ndarray, margin: float) -> np.ndarray:
+        """The nearest point of the edge at least ``margin`` from its ends."""
+        d = self.b - self.a
+        m = margin / float(np.linalg.norm(d))
+        t = np.clip(self.along(p), m, 1.0 - m)
+        return self.a + t[:, None] * d
 
-def _slanted_lines(occ, fi, face, to2d, row_dir, s: Samples, raster, h, nbrs) -> list[_Line]:
+
+def _slanted(face, row_dir, u: np.ndarray) -> bool:
+    """Whether the direction ``u`` (in the plane of ``face``) is neither
+    parallel nor perpendicular to the face's scan rows."""
+    rows = np.cross(np.array(face.normalAt().toTuple()), row_dir)
+    if np.linalg.norm(rows) < 1e-9:
+        return False
+    c = abs(float(u @ rows)) / float(np.linalg.norm(rows))
+    return 1e-6 <= c <= 1 - 1e-6
+
+
+def _slanted_lines(occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs) -> list[_Line]:
     """Sharp straight edges of a planar face, between it and another planar
     face, neither parallel nor perpendicular to the face's scan rows (those
     rows end on them at arbitrary places); with the other face's samples
     within ``LAYER`` h of the edge unfolded into this face's plane (exact for
-    a polyhedral edge: geodesics across it unfold to straight lines)."""
+    a polyhedral edge: geodesics across it unfold to straight lines).  An
+    edge slanted to the other face's rows too slides; one parallel or
+    perpendicular to them holds the ends of that face's lattice and stays."""
     n = np.array(face.normalAt().toTuple())
-    rows = np.cross(n, row_dir)
-    if np.linalg.norm(rows) < 1e-9:
-        return []
-    rows /= np.linalg.norm(rows)
     faces = occ.Faces()
     out = []
     for e, fb in nbrs[fi]:
@@ -304,8 +325,7 @@ def _slanted_lines(occ, fi, face, to2d, row_dir, s: Samples, raster, h, nbrs) ->
         b3 = np.array(e.endPoint().toTuple())
         length = float(np.linalg.norm(b3 - a3))
         u = (b3 - a3) / length
-        c = abs(float(u @ rows))
-        if c < 1e-6 or c > 1 - 1e-6:
+        if not _slanted(face, np.asarray(row_dirs[fi]), u):
             continue
         a2, b2 = to2d(np.stack([a3, b3]))
         # the edge's normal in the face's plane, in 3-D and in plane coordinates
@@ -321,7 +341,8 @@ def _slanted_lines(occ, fi, face, to2d, row_dir, s: Samples, raster, h, nbrs) ->
         dist = np.linalg.norm(q - foot, axis=1)
         near = (t > 0) & (t < length) & (dist < LAYER * h)
         unfolded = foot[near] - dist[near, None] * m3
-        out.append(_Line(a2, b2, m, to2d(unfolded) if near.any() else np.empty((0, 2))))
+        frame = to2d(unfolded) if near.any() else np.empty((0, 2))
+        out.append(_Line(a2, b2, m, frame, _slanted(faces[fb], np.asarray(row_dirs[fb]), u)))
     return out
 
 
@@ -388,7 +409,7 @@ def repair_planar_faces(
         seg = _boundary_segments(face, to2d, h / 20)
         raster = _Raster(seg, h / RASTER)
         lines = (
-            _slanted_lines(occ, fi, face, to2d, np.asarray(row_dirs[fi]), s, raster, h, nbrs)
+            _slanted_lines(occ, fi, face, to2d, row_dirs, s, raster, h, nbrs)
             if row_dirs is not None
             else []
         )
@@ -416,7 +437,12 @@ def repair_planar_faces(
         near_sliding = np.min(
             np.stack([far] + [a.distance(uv) for a in arcs if a.slides], axis=1), axis=1
         )
-        slide = feat & (near_sliding < tol) & ~at_corner
+        # samples on a slanted straight edge slide along it too: the neighbouring
+        # face's samples near it are the frame, whose triangles are judged
+        near_sliding_line = np.min(
+            np.stack([far] + [ln.distance(uv) for ln in lines if ln.slides], axis=1), axis=1
+        )
+        slide = feat & ((near_sliding < tol) | (near_sliding_line < tol)) & ~at_corner
         free = ~feat & ((near_arc < LAYER * h) | (near_line < LAYER * h))
         if not (free.any() or slide.any()):
             continue
@@ -441,11 +467,12 @@ def repair_planar_faces(
                 free,
                 h,
                 slide=slide,
-                project=_project_onto(arcs, 0.3 * h) if arcs else None,
+                project=_project_onto(arcs + lines, 0.3 * h) if arcs or lines else None,
                 inside=raster,
                 ghosts=_ghosts(arcs, sides, h) if arcs else None,
                 clamp=_chain(clamps),
                 frame=frame,
+                judge_frame=True,
                 max_edits=None if arcs else LINE_EDITS,
             )
         r = done[key]

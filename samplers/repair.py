@@ -42,6 +42,7 @@ SEPARATION = 12.0  # bad triangles edited at once are this far apart, times h
 MOVABLE = 3.0  # a layout's samples this near (times h) a defect it repairs may move
 REACH = 4.0  # in a local descent, triangles with a longer edge (times h) join two regions
 _EDGES = np.array([[0, 1], [1, 2], [2, 0]])
+GHOST, FRAME = -1, -2  # the sample id of a ghost point and of a frame point
 
 
 @dataclass(frozen=True)
@@ -69,7 +70,19 @@ class Repaired:
 class _Problem:
     """Samples with their roles and the face's callbacks."""
 
-    def __init__(self, uv, free, slide, project, inside, h, ghosts=None, clamp=None, frame=None):
+    def __init__(
+        self,
+        uv,
+        free,
+        slide,
+        project,
+        inside,
+        h,
+        ghosts=None,
+        clamp=None,
+        frame=None,
+        judge_frame=False,
+    ):
         self.uv = np.asarray(uv, dtype=np.float64).copy()
         self.free = np.asarray(free, dtype=bool).copy()
         self.slide = np.asarray(slide, dtype=bool).copy()
@@ -80,6 +93,7 @@ class _Problem:
         self.ghosts = ghosts
         self.clamp = clamp
         self.frame = np.empty((0, 2)) if frame is None else np.asarray(frame, dtype=np.float64)
+        self.frame_id = FRAME if judge_frame else GHOST
         self._watch: np.ndarray | None = None
 
     def watch(self) -> np.ndarray:
@@ -118,20 +132,21 @@ class _Problem:
         return c
 
     def extended(self, subset=None):
-        """Points (with the ghosts, standing for sample -1) and the sample each is."""
+        """Points (with the ghosts, standing for sample -1, and the frame, -2
+        when its triangles are judged, else -1) and the sample each is."""
         idx = np.arange(self.uv.shape[0]) if subset is None else subset
         pts = self.uv[idx]
         of = idx
         if self.ghosts is not None:
             g = self.ghosts(self.uv[idx[self.slide[idx]]])
             pts = np.vstack([pts, g])
-            of = np.concatenate([of, np.full(g.shape[0], -1)])
+            of = np.concatenate([of, np.full(g.shape[0], GHOST)])
         if self.frame.shape[0] and idx.size:
             lo = self.uv[idx].min(axis=0) - 3 * self.h
             hi = self.uv[idx].max(axis=0) + 3 * self.h
             f = self.frame[((self.frame >= lo) & (self.frame <= hi)).all(axis=1)]
             pts = np.vstack([pts, f])
-            of = np.concatenate([of, np.full(f.shape[0], -1)])
+            of = np.concatenate([of, np.full(f.shape[0], self.frame_id)])
         return pts, of
 
 
@@ -143,8 +158,10 @@ def _triangles(prob: _Problem, subset=None):
         tri = Delaunay(pts).simplices
     except QhullError:
         return pts, of, np.empty((0, 3), dtype=np.int64)
-    tri = tri[prob.inside(pts[tri].mean(axis=1))]
-    return pts, of, tri
+    # a triangle across a straight edge (on the frame) is judged with the face's
+    # own: its geodesic is the straight line of the unfolding
+    keep = prob.inside(pts[tri].mean(axis=1)) | (of[tri] == FRAME).any(axis=1)
+    return pts, of, tri[keep]
 
 
 def _energy(prob: _Problem, subset=None, active=None):
@@ -154,10 +171,20 @@ def _energy(prob: _Problem, subset=None, active=None):
     grad = np.zeros_like(prob.uv)
     if tri.shape[0] == 0:
         return 0.0, grad, np.empty(0), tri
-    tri = tri[(of[tri] >= 0).all(axis=1)]  # triangles on a ghost are not the face's
+    # triangles on a ghost are not the face's; those on the frame are, when they
+    # have a movable sample (the rest of the frame's cannot change)
+    kind = of[tri]
+    tri = tri[
+        (kind != GHOST).all(axis=1)
+        & (kind >= 0).any(axis=1)
+        & (
+            (kind >= 0).all(axis=1)
+            | ((kind >= 0) & (prob.free | prob.slide)[np.maximum(kind, 0)]).any(axis=1)
+        )
+    ]
     watch = prob.watch()
     active = watch if active is None else active & watch
-    tri = tri[active[of[tri]].any(axis=1)]
+    tri = tri[(active[np.maximum(of[tri], 0)] & (of[tri] >= 0)).any(axis=1)]
     p = pts[tri]
     vec = p[:, _EDGES[:, 0]] - p[:, _EDGES[:, 1]]  # (m, 3, 2)
     length = np.linalg.norm(vec, axis=2)
@@ -191,7 +218,8 @@ def _energy(prob: _Problem, subset=None, active=None):
         push(np.full(tri.shape[0], col), -short[:, col] / h)
     # samples sliding along one edge keep their spacing within [0.75 h, 1.35 h]:
     # the lattice of the face on the other side starts from them
-    both = prob.slide[of[tri[:, _EDGES[:, 0]]]] & prob.slide[of[tri[:, _EDGES[:, 1]]]]
+    ends = of[tri[:, _EDGES]]  # (m, 3, 2) sample ids of every edge's ends
+    both = ((ends >= 0) & prob.slide[np.maximum(ends, 0)]).all(axis=2)
     if both.any():
         gap = (
             np.where(
@@ -296,6 +324,7 @@ def repair(
     ghosts: Callable[[np.ndarray], np.ndarray] | None = None,
     clamp: Callable[[np.ndarray], np.ndarray] | None = None,
     frame=None,
+    judge_frame: bool = False,
     descent_steps: int = 300,
     max_edits: int | None = None,
 ) -> Repaired:
@@ -328,8 +357,14 @@ def repair(
         to keep them on the face (a free sample must not cross its edge).
     frame : (g, 2) array_like of float, optional
         Fixed points standing for a neighbouring face (unfolded across a
-        straight edge); like the ghosts they block Delaunay triangles across
-        the edge and are never moved nor judged.
+        straight edge, or across the cut of a developed cone); like the
+        ghosts they block Delaunay triangles across the edge and are never
+        moved.
+    judge_frame : bool
+        Judge the triangles joining the frame to a movable sample too (their
+        geodesic edges unfold straight across a polyhedral edge, whose
+        samples may then slide).  Not where the frame holds images of the
+        face's own samples, which may move while their images do not.
     descent_steps, max_edits : int
         Work limits (``max_edits`` defaults to an eighth of the movable
         samples, at least 80).
@@ -372,6 +407,7 @@ def repair(
         ghosts,
         clamp,
         frame,
+        judge_frame,
     )
     _descend(prob, descent_steps)
     nbad, _, bad, worst = _status(prob)
@@ -444,7 +480,10 @@ def _regions(prob: _Problem, bad: np.ndarray, skip: set) -> list[tuple[np.ndarra
     """Bad triangles to edit at once: in order of their centres (x, then y),
     skipping those already found stuck, each at least ``SEPARATION`` h from
     the ones taken before it, so that their edits do not interact."""
-    centres = prob.uv[bad].mean(axis=1)
+    real = bad >= 0  # a frame point is no sample: the centre is that of the real corners
+    centres = (prob.uv[np.maximum(bad, 0)] * real[..., None]).sum(axis=1) / real.sum(axis=1)[
+        :, None
+    ]
     order = np.lexsort((centres[:, 1], centres[:, 0]))
     taken: list[int] = []
     for i in order.tolist():
@@ -468,7 +507,7 @@ def _best_edits(prob: _Problem, regions, skip: set) -> list[tuple[tuple, np.ndar
     """
     h = prob.h
     cands = [
-        [("del", int(v)) for v in tri if prob.free[v]] + [("add", centre)]
+        [("del", int(v)) for v in tri if v >= 0 and prob.free[v]] + [("add", centre)]
         for tri, centre in regions
     ]
     before = [_status(prob, *_local(prob, centre, 5.0 * h))[:2] for _, centre in regions]

@@ -249,6 +249,26 @@ def _axis_index(u: np.ndarray) -> int | None:
     return k if abs(abs(u[k]) - 1.0) < 1e-12 else None
 
 
+def _even_ends(s: np.ndarray, length: float, clear: float) -> np.ndarray:
+    """Lattice positions on a segment ``[0, length]`` whose ends are sampled
+    corners or edges: positions nearer than ``clear`` to an end are dropped
+    (:func:`_drop_near_features` would drop them) and an end gap wider than
+    ``2 clear`` gets a position in its middle.  A lattice anchored elsewhere
+    leaves any gap up to ``clear`` plus its spacing at an end; the right
+    triangle it makes with the end's samples breaks Condition III-ii once
+    its legs differ by half (a star prism's first column 1.8 h from its
+    reflex edge: ratio 0.875)."""
+    s = s[(s >= clear) & (s <= length - clear)]
+    if s.size == 0:
+        return s
+    extra = []
+    if s[0] > 2 * clear:
+        extra.append(s[0] / 2)
+    if length - s[-1] > 2 * clear:
+        extra.append((length + s[-1]) / 2)
+    return np.sort(np.concatenate([s, extra]))
+
+
 def _sample_chain(
     chain,
     closed: bool,
@@ -258,6 +278,7 @@ def _sample_chain(
     edge_lattices=(),
     ratio: float = 1.0,
     sphere=None,
+    clear: float = 0.0,
 ) -> np.ndarray:
     """Samples along a chain of edges, about ``step`` apart.
 
@@ -270,8 +291,9 @@ def _sample_chain(
     (``edge_lattices``, from :func:`_feature_samples`) takes the lattice of
     the nearest such edge instead (anchored at its start, ``ratio`` times
     its step), so that the row next to the edge does not stagger against
-    the edge's samples (a star prism's sides, a wedge's slanted faces).
-    An open section of a partial sphere (``sphere``, from
+    the edge's samples (a star prism's sides, a wedge's slanted faces);
+    its gaps at the row's ends are evened (:func:`_even_ends`, with
+    ``clear``).  An open section of a partial sphere (``sphere``, from
     :func:`_sphere_frame`) is sampled by :func:`_sphere_row`.  Any other
     chain is sampled at equal arc-length steps from its start (for a closed
     section of a surface of revolution: from the seam, so rows line up too).
@@ -282,6 +304,7 @@ def _sample_chain(
         b = np.array(e.endPoint().toTuple())
         length = float(np.linalg.norm(b - a))
         u = (b - a) / length
+        aligned = True
         if axis_steps is not None:
             # a row along a coordinate axis steps like the planes across that
             # axis (the extent over a whole number of steps), so that its
@@ -296,11 +319,14 @@ def _sample_chain(
                     off = [np.linalg.norm((mid - ea) - ((mid - ea) @ u) * u) for ea, _ in par]
                     anchor, es = par[int(np.argmin(off))]
                     step = ratio * es
+                    aligned = False
         c0 = float((a - anchor) @ u)
         first = math.ceil(c0 / step - 1e-9)
         last = math.floor((c0 + length) / step + 1e-9)
         s = np.arange(first, last + 1) * step - c0
         s = s[(s > 1e-9 * length) & (s < length * (1 - 1e-9))]
+        if not aligned and clear > 0:
+            s = _even_ends(s, length, clear)
         s = np.concatenate([[0.0], s, [length]])
         return a + s[:, None] * u
     if sphere is not None and not closed:
@@ -444,8 +470,9 @@ def _row_crossings(a, u, length, adjacent, faces, planes, step):
     along the rows).  Sampled at their crossings, the edge holds the ends of
     that face's rows or columns, which then end on edge samples instead of
     staggering against equal arc-length ones.  Returns the arc lengths of
-    the crossings (none nearer than ``step`` / 2 to either end, where the
-    corners are) and their spacing, or None.
+    the samples (the crossings with the ends evened by :func:`_even_ends`:
+    the corners are sampled), their spacing and the arc length of one
+    crossing (the lattice's anchor), or None.
     """
     if planes is None:
         return None
@@ -473,12 +500,12 @@ def _row_crossings(a, u, length, adjacent, faces, planes, step):
                 math.ceil((ends[0] - offset) / gap - 1e-9),
                 math.floor((ends[1] - offset) / gap + 1e-9) + 1,
             )
-            sj = np.sort((offset + j * gap - float(a @ normal)) / un)
-            sj = sj[(sj >= step / 2) & (sj <= length - step / 2)]
-            best = (spacing, sj)
+            lattice = np.sort((offset + j * gap - float(a @ normal)) / un)
+            if lattice.size:
+                best = (spacing, _even_ends(lattice, length, FEATURE_CLEARANCE * step), lattice[0])
     if best is None or best[1].size == 0:
         return None
-    return best[1], best[0]
+    return best[1], best[0], best[2]
 
 
 def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=None):
@@ -521,7 +548,7 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
             a = np.array(edge.startPoint().toTuple())
             u = (np.array(edge.endPoint().toTuple()) - a) / length
             cross = _row_crossings(a, u, length, fids, faces, planes, step)
-            lattice = (a, u, length / m) if cross is None else (a + cross[0][0] * u, u, cross[1])
+            lattice = (a, u, length / m) if cross is None else (a + cross[2] * u, u, cross[1])
             for k in fids:
                 lattices.setdefault(k, []).append(lattice)
         if cross is not None:
@@ -739,6 +766,7 @@ def scan(
                     lattices.get(fi, ()),
                     ratio,
                     sphere,
+                    FEATURE_CLEARANCE * h,
                 )
                 pts.extend(p)
                 fids.extend([fi] * len(p))

@@ -116,3 +116,48 @@ def test_free_samples_keep_half_h_from_a_cylinders_rim():
     r = np.linalg.norm(out - [[0, 0], [0, 0], [5, 0], [5, 0]], axis=1)
     np.testing.assert_allclose(r, [1.05, 1.2, 1.025, 1.3])
     np.testing.assert_allclose(out[:, 1], p[:, 1])  # moved along the radius
+
+
+def test_triangles_across_a_straight_edge_are_judged():
+    """Samples on a straight edge x = 0 slide along it; the neighbouring face
+    stands beyond it as a fixed frame (unfolded), its column half a step off
+    the face's rows.  Every edge sample then sits in two frame triangles of
+    ratio 1 while the face's own triangles are right triangles: the repair
+    must see the triangles across the edge (it once judged only the face's)
+    and slide the edge samples to a compromise that meets Condition III-ii
+    on both sides."""
+    y = np.arange(0.0, 10.0)
+    face = np.stack(np.meshgrid(np.arange(0.0, 6.0), y), -1).reshape(-1, 2)
+    on_edge = face[:, 0] == 0.0
+    slide = on_edge & (face[:, 1] > 0) & (face[:, 1] < 9)  # the edge's ends stay
+    frame = np.stack([np.full(11, -1.0), np.arange(-0.5, 10.0)], 1)
+    frame = np.vstack([frame, frame - [1.0, 0.0]])
+
+    def project(p):
+        return np.stack([np.zeros(len(p)), np.clip(p[:, 1], 0.5, 8.5)], 1)
+
+    r = repair(
+        face,
+        np.zeros(len(face), bool),
+        1.0,
+        slide=slide,
+        project=project,
+        inside=lambda c: c[:, 0] > -1e-9,
+        clamp=lambda p: np.stack([np.maximum(p[:, 0], 0.4), p[:, 1]], 1),
+        frame=frame,
+        judge_frame=True,
+    )
+    moved = r.uv[np.isin(r.origin, np.flatnonzero(slide))]
+    assert np.abs(moved[:, 0]).max() < 1e-12  # still on the edge
+    # judged here independently: every Delaunay triangle of the face and the
+    # frame with a sample of the face, along the middle of the edge (at its
+    # fixed ends the frame's offset cannot be mended)
+    pts = np.vstack([r.uv, frame])
+    tri = Delaunay(pts).simplices
+    tri = tri[(tri < len(r.uv)).any(axis=1)]
+    p = pts[tri]
+    middle = (np.abs(p[:, :, 1] - 4.5) < 3.0).all(axis=1) & (p[:, :, 0] < 1.5).all(axis=1)
+    e = np.sort(np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2), axis=1)
+    rho = e[:, 1] / e[:, 2]
+    assert middle.sum() > 15
+    assert rho[middle].max() < np.sqrt(3) / 2

@@ -129,3 +129,19 @@ def test_bad_arguments(box, kwargs, msg):
 def test_not_a_shape():
     with pytest.raises(SamplingError, match="shape must be a samplers Shape or a CadQuery shape"):
         scan(np.zeros((3, 3)), 0.1)
+
+
+def test_even_ends_split_a_wide_end_gap():
+    """A lattice anchored off a segment's ends (a star prism's side, its
+    columns taken from a slanted edge) drops positions nearer than the
+    clearance to an end and splits an end gap wider than twice it: the
+    reflex edge's neighbours stood 1.8 h off (ratio 0.875)."""
+    from samplers.scanline import _even_ends
+
+    lattice = np.arange(0.6, 8.0, 1.2)  # 0.6, 1.8, ..., 7.8 on [0, 10]
+    out = _even_ends(lattice, 10.0, 0.75)
+    np.testing.assert_allclose(out, np.r_[0.9, np.arange(1.8, 7.9, 1.2), 8.9])
+    # gaps within twice the clearance stay as they are
+    kept = np.arange(1.0, 9.5, 1.0)
+    np.testing.assert_allclose(_even_ends(kept, 10.0, 0.75), kept)
+    assert _even_ends(np.array([0.2, 9.9]), 10.0, 0.75).size == 0
