@@ -679,7 +679,9 @@ APEX_KEEP = 5.0  # samples this near the apex (times t) stay
 CONE_SEAM = 1.5  # samples this near (times t) the cut of a developed cone stay fixed
 
 
-def _repair_developed(rho, ang, row, rim_ang, slant: float, sin_a: float, t: float):
+def _repair_developed(
+    rho, ang, row, rim_ang, slant: float, sin_a: float, t: float, apex_keep: float = APEX_KEEP
+):
     """Repair a cone's rings where they break Condition III-ii, on the cone's development.
 
     A cone is isometric to a plane sector of angle ``2 pi sin(a)``: a sample
@@ -696,9 +698,13 @@ def _repair_developed(rho, ang, row, rim_ang, slant: float, sin_a: float, t: flo
     0.86, within the condition, were pushed about by the repair's margin:
     1.9% of the samples violating); letting the apex's neighbourhood move
     left conebox's reconstruction 12 open edges round its apex.
+    With ``sin_a`` 1 the development is a disk with no cut (a smooth
+    pole's neighbourhood, mapped by distance and angle about it), and
+    ``apex_keep`` (times t) sets the fixed neighbourhood of the apex.
     Returns the new (rho, ang, row; -1 for an added sample), the triangles
     left above the repair's margin and the worst ratio.
     """
+    full = sin_a >= 1.0 - 1e-12
     theta = 2 * math.pi * sin_a
     psi = ang * sin_a
     uv = np.stack([rho * np.cos(psi), rho * np.sin(psi)], axis=1)
@@ -708,9 +714,9 @@ def _repair_developed(rho, ang, row, rim_ang, slant: float, sin_a: float, t: flo
     allpsi = np.r_[psi, rim_psi, 0.0]
     allrho = np.r_[rho, np.full(rim.shape[0], slant), 0.0]
     # images across the cut: samples near either side turned by -theta or +theta
-    frame = []
+    frame = [np.empty((0, 2))]
     reach = 3 * t / np.maximum(allrho, t)
-    for sign, side in ((1.0, allpsi < reach), (-1.0, allpsi > theta - reach)):
+    for sign, side in () if full else ((1.0, allpsi < reach), (-1.0, allpsi > theta - reach)):
         side &= allrho > 0  # not the apex
         a = allpsi[side] + sign * theta
         frame.append(allrho[side][:, None] * np.stack([np.cos(a), np.sin(a)], axis=1))
@@ -718,7 +724,7 @@ def _repair_developed(rho, ang, row, rim_ang, slant: float, sin_a: float, t: flo
     def inside(c: np.ndarray) -> np.ndarray:
         r = np.linalg.norm(c, axis=1)
         a = np.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
-        return (r < slant) & (a > 0) & (a < theta)
+        return (r < slant) & (full | ((a > 0) & (a < theta)))
 
     n = uv.shape[0]
     frame = np.vstack(frame)
@@ -733,7 +739,7 @@ def _repair_developed(rho, ang, row, rim_ang, slant: float, sin_a: float, t: flo
         near = cKDTree(broken).query(uv)[0] <= MOVABLE * t
     # distance to the cut, either side (along the arc, the sector's angle from 0 and from theta)
     arc = np.minimum(psi, theta - psi) * rho
-    free = near & (arc > CONE_SEAM * t) & (rho > APEX_KEEP * t)
+    free = near & (full | (arc > CONE_SEAM * t)) & (rho > apex_keep * t)
     if not free.any():
         return rho, ang, row, 0, 0.0
     fixed_free = np.r_[free, np.zeros(rim.shape[0] + 1, dtype=bool)]
@@ -804,6 +810,54 @@ def _halving_count(x: float) -> int:
     return best
 
 
+POLE_REACH = 10  # rings nearer a smooth pole than this (times t) are repaired
+
+
+def _repair_pole(ring, columns, faces, t: float, end: int):
+    """Repair the rings round a smooth pole (a sphere's) of a body of revolution.
+
+    Near the pole the rings halve like a disk's (every other column ends),
+    and where they halve Delaunay triangles break Condition III-ii (the
+    revolved cone tip: 54 triangles within 6 t of its ball's pole).  The
+    pole's neighbourhood is mapped by distance along the meridian and angle
+    about the axis (its azimuthal equidistant map: within ``POLE_REACH`` t
+    of a pole of a sphere of radius R, circles shrink by at most
+    ``sin(x) / x`` at ``x = POLE_REACH t / R``) and repaired there as a
+    developed cone without a cut (:func:`_repair_developed`), the pole and
+    the ring at ``POLE_REACH`` t fixed.  ``end`` 0 is the pole before the
+    first ring, 1 the one after the last.  Returns the rings replaced, per
+    new sample its (distance from the pole, angle) and ring (-1 for an
+    added sample), and a report; or ``([], [], [], None)`` when the face at
+    that end is no sphere (a cone's apex is left as it is: repaired, its
+    samples opened the tip's reconstruction, 9 open edges), or the sphere
+    or the body is too short.
+    """
+    n = len(ring)
+    order = list(range(n)) if end == 0 else list(range(n - 1, -1, -1))
+    if n <= POLE_REACH + 1 or faces[ring[order[0]][0]].geomType() != "SPHERE":
+        return [], [], [], None
+    inner = order[: POLE_REACH - 1]  # rings 1 .. POLE_REACH - 1 steps from the pole
+    rim = order[POLE_REACH - 1]
+    if any(ring[j][0] != ring[rim][0] for j in inner):
+        return [], [], [], None  # the sphere ends before the rim: the map would cross faces
+    rho = np.concatenate([np.full(columns[j].size, (k + 1) * t) for k, j in enumerate(inner)])
+    ang = np.concatenate([columns[j] for j in inner])
+    row = np.concatenate([np.full(columns[j].size, j) for j in inner])
+    r2, a2, row2, bad, worst = _repair_developed(
+        rho, ang, row, columns[rim], POLE_REACH * t, 1.0, t, apex_keep=0.5
+    )
+    report = {
+        "kind": "pole",
+        "face": int(ring[order[0]][0]),
+        "samples": int(rho.size),
+        "added": int((row2 < 0).sum()),
+        "removed": int(rho.size - (row2 >= 0).sum()),
+        "bad": int(bad),
+        "worst": float(worst),
+    }
+    return inner, list(zip(r2.tolist(), a2.tolist())), row2.tolist(), report
+
+
 def _revolution_axis(face):
     """(point, unit direction) of a cone's or sphere's axis."""
     g = face._geomAdaptor()
@@ -864,15 +918,17 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     rows = max(2, round(total / h))
     t = total / rows
     umin = [f._uvBounds()[0] for f in faces]
-    ring = []  # (face, axial, radial) per row 1 .. rows - 1
-    for j in range(1, rows):
-        sj = j * t
-        k = int(np.searchsorted(starts, sj, side="right") - 1)
+
+    def at(sj: float) -> tuple[int, float, float]:
+        """(face, axial, radial) of the meridian point at arc length ``sj``."""
+        k = int(np.clip(np.searchsorted(starts, sj, side="right") - 1, 0, len(parts) - 1))
         fi, v, _, _ = parts[k]
         vj = float(np.interp(sj - starts[k], seg[k], v))
         p = np.array(faces[fi]._geomAdaptor().Value(umin[fi], vj).Coord()) - o
         z = float(p @ axis)
-        ring.append((fi, z, float(np.linalg.norm(p - z * axis))))
+        return fi, z, float(np.linalg.norm(p - z * axis))
+
+    ring = [at(j * t) for j in range(1, rows)]  # (face, axial, radial) per row 1 .. rows - 1
     radial = np.array([r for _, _, r in ring])
     widest = int(np.argmax(radial))
     ex = _perpendicular(axis)
@@ -890,7 +946,23 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
             j += step
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     pts, ids, fids = [], [], []
+    poles: list[int] = []
+    reports: list[dict] = []
+    for end in (0, 1):
+        pole_rows, p_ang, p_row, report = _repair_pole(ring, columns, faces, t, end)
+        if report is None:
+            continue
+        poles += pole_rows
+        for a, j in zip(p_ang, p_row):
+            dist = a[0] if end == 0 else total - a[0]
+            fi, z, r = at(dist)
+            pts.append(o + z * axis + r * (math.cos(a[1]) * ex + math.sin(a[1]) * ey))
+            ids.append(np.array([line + j if j >= 0 else -3]))
+            fids.append(np.array([fi]))
+        reports.append(report)
     for j, (fi, z, r) in enumerate(ring):
+        if j in poles:
+            continue
         ang = columns[j]
         pts.append(o + z * axis + r * (np.cos(ang)[:, None] * ex + np.sin(ang)[:, None] * ey))
         ids.append(np.full(ang.size, line + j))
@@ -903,4 +975,6 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         np.concatenate(fids),
         np.zeros(new.shape[0], dtype=bool),
     )
-    return [{"kind": "revolved rings", "rows": len(ring), "columns": m, "samples": len(new)}]
+    return [
+        {"kind": "revolved rings", "rows": len(ring), "columns": m, "samples": len(new)}
+    ] + reports

@@ -299,29 +299,34 @@ def test_repairs_are_reported_and_congruent_ends_agree(sampled):
 
 def test_revolved_body_is_laid_out_in_rings():
     """cone_tip (a cone and a ball meeting smoothly): one ring per meridian step,
-    the columns of a ring a subset of the widest ring's, on the surface."""
+    the columns of a ring a subset of the widest ring's, on the surface;
+    except round the ball's pole, whose rings are repaired (below)."""
     import math
+
+    from samplers.layers import POLE_REACH
 
     s = shapes.build("cone_tip")
     r = scan(s)
     (rep,) = [x for x in r.meta["repairs"] if x["kind"] == "revolved rings"]
     off = np.hypot(r.points[:, 0], r.points[:, 1]) > 1e-9
     assert int(off.sum()) == rep["samples"]
+    pole = r.points[~off][np.argmin(r.points[~off, 2])]
+    far = np.linalg.norm(r.points - pole, axis=1) > (POLE_REACH - 0.5) * r.meta["spacing"]
+    assert (off & ~far).sum() > 100
+    off &= far
     z = np.round(r.points[off, 2], 9)
-    assert np.unique(z).size == rep["rows"]
+    assert np.unique(z).size == rep["rows"] - (POLE_REACH - 1)
     ang = np.arctan2(r.points[off, 1], r.points[off, 0]) % (2 * math.pi)
     step = 2 * math.pi / rep["columns"]
     k = ang / step - ang[0] / step
     assert np.abs(k - np.round(k)).max() < 1e-6  # every column is one of the widest ring's
     # the widest ring halves down to the poles: 3, 4 or 5 times a power of two columns,
-    # and the rings next to the poles (the apex, the ball's top) have at most 5
+    # and the ring next to the apex has at most 5
     c = rep["columns"]
     while c % 2 == 0 and c > 5:
         c //= 2
     assert c in (3, 4, 5)
-    rings = np.unique(z)
-    for end in (rings[0], rings[-1]):
-        assert 3 <= np.count_nonzero(z == end) <= 5
+    assert 3 <= np.count_nonzero(z == z.max()) <= 5
     from validators.fidelity import distance_to_surface
 
     d = distance_to_surface(r.points, s.truth_vertices, s.truth_triangles)
@@ -402,7 +407,32 @@ def test_square_ring_meets_condition_iii(sampled):
     assert np.nanmax(rep.worst_ratio) < np.sqrt(3) / 2
 
 
-@pytest.mark.parametrize("name", ["cylinder", "square_ring"])
+def test_rings_round_a_smooth_pole_are_repaired(sampled):
+    """The rings round the cone tip's ball's pole halve like a disk's, and
+    where they halved 54 intrinsic Delaunay triangles broke Condition III-ii
+    (2.32% of the samples); repaired on the pole's azimuthal map, no sample
+    within POLE_REACH steps of the pole breaks it (0.60% of the samples
+    left, all round the cone's apex, which stays: moving it opened the
+    tip's reconstruction)."""
+    pytest.importorskip("potpourri3d")
+    from samplers.layers import POLE_REACH
+    from validators.conditions import sample_conditions
+
+    s, r = sampled["cone_tip"]
+    (pole_rep,) = [x for x in r.meta["repairs"] if x["kind"] == "pole"]
+    assert pole_rep["added"] + pole_rep["removed"] > 0
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    bad = ~(rep.worst_ratio < np.sqrt(3) / 2) & np.isfinite(rep.worst_ratio)
+    on_axis = np.hypot(r.points[:, 0], r.points[:, 1]) < 1e-9
+    pole = r.points[on_axis][np.argmin(r.points[on_axis, 2])]
+    apex = r.points[on_axis][np.argmax(r.points[on_axis, 2])]
+    near = np.linalg.norm(r.points - pole, axis=1) < (POLE_REACH + 2) * r.meta["spacing"]
+    assert near.sum() > 200 and not bad[near].any()
+    assert np.linalg.norm(r.points[bad] - apex, axis=1).max() < 10 * r.meta["spacing"]
+    assert bad.mean() < 0.01
+
+
+@pytest.mark.parametrize("name", ["cylinder", "square_ring", "cone_tip"])
 def test_ring_laid_shapes_reconstruct_with_their_topology(sampled, name):
     from sr33 import reconstruct
 
