@@ -437,8 +437,9 @@ def repair_planar_faces(
         near_sliding = np.min(
             np.stack([far] + [a.distance(uv) for a in arcs if a.slides], axis=1), axis=1
         )
-        # samples on a slanted straight edge slide along it too: the neighbouring
-        # face's samples near it are the frame, whose triangles are judged
+        # samples on a straight edge slanted to both faces' rows slide along it
+        # too: the other face's samples near it are the frame, whose triangles
+        # are judged
         near_sliding_line = np.min(
             np.stack([far] + [ln.distance(uv) for ln in lines if ln.slides], axis=1), axis=1
         )
