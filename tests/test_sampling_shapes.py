@@ -143,6 +143,24 @@ def test_rows_parallel_to_a_slanted_edge_share_its_lattice(sampled):
     assert split > 0
 
 
+def lateral_edge_samples(solid, r):
+    """Per edge of ``solid`` along no horizontal direction (a pyramid's
+    lateral edges; the base's run along the rows or across them): the edge,
+    the arc length along it of every sample, the feature samples strictly
+    between its ends, and its length."""
+    p = r.points
+    for e in solid.Edges():
+        a = np.array(e.startPoint().toTuple())
+        u = np.array(e.endPoint().toTuple()) - a
+        length = np.linalg.norm(u)
+        u /= length
+        if abs(u[2]) < 1e-9:
+            continue
+        t = (p - a) @ u
+        on = r.on_feature & (np.linalg.norm(p - a - t[:, None] * u, axis=1) < 1e-9)
+        yield e, t, on & (t > 1e-9) & (t < length - 1e-9), length
+
+
 def test_slanted_edges_hold_the_ends_of_their_faces_lattice_lines(sampled):
     """A pyramid's lateral edges run slanted to the rows of both faces they
     bound: they are sampled where one face's lattice lines (its rows, or the
@@ -170,25 +188,17 @@ def test_slanted_edges_hold_the_ends_of_their_faces_lattice_lines(sampled):
             lines.append((normal, c[0], step))
         lattice[fi] = lines
     slanted = 0
-    for e in s.solid.Edges():
-        a = np.array(e.startPoint().toTuple())
-        u = np.array(e.endPoint().toTuple()) - a
-        length = np.linalg.norm(u)
-        u /= length
-        if abs(u[2]) < 1e-9:
-            continue  # the base's edges run along the rows or across them
+    for e, t, on, length in lateral_edge_samples(s.solid, r):
         slanted += 1
-        t = (p - a) @ u
-        on = r.on_feature & (np.linalg.norm(p - a - t[:, None] * u, axis=1) < 1e-9)
-        on &= (t > 1e-9) & (t < length - 1e-9)
         q = np.sort(t[on])
         gaps = np.diff(q[1:-1])
         np.testing.assert_allclose(gaps, gaps[0], rtol=1e-9)
         assert h <= gaps[0] <= 1.45 * h
         assert q[0] >= 0.75 * h and length - q[-1] >= 0.75 * h
         adjacent = [fi for fi, f in enumerate(faces) if any(e.isSame(x) for x in f.Edges())]
+        middle = p[on][np.argsort(t[on])][1:-1]  # the end samples may be splits
         ends = [
-            np.allclose(((p[on][1:-1] @ nrm - c0) / step + 0.5) % 1.0, 0.5, atol=1e-6)
+            np.allclose(((middle @ nrm - c0) / step + 0.5) % 1.0, 0.5, atol=1e-6)
             for fi in adjacent
             for nrm, c0, step in lattice[fi]
         ]
@@ -203,19 +213,11 @@ def test_edges_slanted_to_both_faces_rows_slide_along_them(sampled):
     between h / 2 and 1.6 h from each other and from the corners (the
     repair's soft bounds are 0.75 h and 1.35 h; 0.57 h to 1.55 h measured)."""
     s, r = sampled["pyramid"]
-    p, h = r.points, r.meta["spacing"]
+    h = r.meta["spacing"]
     lateral = 0
-    for e in s.solid.Edges():
-        a = np.array(e.startPoint().toTuple())
-        u = np.array(e.endPoint().toTuple()) - a
-        length = np.linalg.norm(u)
-        u /= length
-        if abs(u[2]) < 1e-9:
-            continue
+    for _, t, on, length in lateral_edge_samples(s.solid, r):
         lateral += 1
-        t = (p - a) @ u
-        on = r.on_feature & (np.linalg.norm(p - a - t[:, None] * u, axis=1) < 1e-9)
-        q = np.sort(t[on & (t > 1e-9) & (t < length - 1e-9)])
+        q = np.sort(t[on])
         assert q.size > 0.5 * length / h
         gaps = np.diff(np.r_[0.0, q, length])
         assert gaps.min() > 0.5 * h and gaps.max() < 1.6 * h
