@@ -156,7 +156,7 @@ def _arcs(face, to2d, across=()) -> list[_Arc]:
     return out
 
 
-def _nearest_arc(arcs: list, p: np.ndarray) -> np.ndarray:
+def _nearest_curve(arcs: list, p: np.ndarray) -> np.ndarray:
     """Index of the curve (arc or line) nearest to each point."""
     return np.argmin(np.stack([a.distance(p) for a in arcs], axis=1), axis=1)
 
@@ -166,7 +166,7 @@ def _project_onto(curves: list, margin: float):
     lines), at least ``margin`` from the curve's ends."""
 
     def project(p: np.ndarray) -> np.ndarray:
-        which = _nearest_arc(curves, p)
+        which = _nearest_curve(curves, p)
         out = p.copy()
         for k, a in enumerate(curves):
             sel = which == k
@@ -191,7 +191,7 @@ def _ghosts(arcs: list[_Arc], sides: list[float], h: float):
         p = p[np.min(np.stack([a.distance(p) for a in arcs], axis=1), axis=1) < 1e-6 * h]
         if p.shape[0] == 0:
             return np.empty((0, 2))
-        which = _nearest_arc(arcs, p)
+        which = _nearest_curve(arcs, p)
         out = []
         for k, a in enumerate(arcs):
             q = p[which == k]
@@ -434,16 +434,12 @@ def repair_planar_faces(
             cKDTree(corners).query(uv)[0] < tol if corners.shape[0] else np.zeros(len(uv), bool)
         )
         feat = s.on_feature[idx]
-        near_sliding = np.min(
-            np.stack([far] + [a.distance(uv) for a in arcs if a.slides], axis=1), axis=1
-        )
-        # samples on a straight edge slanted to both faces' rows slide along it
-        # too: the other face's samples near it are the frame, whose triangles
-        # are judged
-        near_sliding_line = np.min(
-            np.stack([far] + [ln.distance(uv) for ln in lines if ln.slides], axis=1), axis=1
-        )
-        slide = feat & ((near_sliding < tol) | (near_sliding_line < tol)) & ~at_corner
+        # samples on a full cylinder's rim, or on a straight edge slanted to
+        # both faces' rows, slide along it (for the edge, the other face's
+        # samples near it are the frame, whose triangles are judged)
+        sliding = [c for c in arcs + lines if c.slides]
+        near_sliding = np.min(np.stack([far] + [c.distance(uv) for c in sliding], axis=1), axis=1)
+        slide = feat & (near_sliding < tol) & ~at_corner
         free = ~feat & ((near_arc < LAYER * h) | (near_line < LAYER * h))
         if not (free.any() or slide.any()):
             continue

@@ -174,14 +174,9 @@ def _energy(prob: _Problem, subset=None, active=None):
     # triangles on a ghost are not the face's; those on the frame are, when they
     # have a movable sample (the rest of the frame's cannot change)
     kind = of[tri]
-    tri = tri[
-        (kind != GHOST).all(axis=1)
-        & (kind >= 0).any(axis=1)
-        & (
-            (kind >= 0).all(axis=1)
-            | ((kind >= 0) & (prob.free | prob.slide)[np.maximum(kind, 0)]).any(axis=1)
-        )
-    ]
+    real = kind >= 0
+    movable = real & (prob.free | prob.slide)[np.maximum(kind, 0)]
+    tri = tri[(kind != GHOST).all(axis=1) & (real.all(axis=1) | movable.any(axis=1))]
     watch = prob.watch()
     active = watch if active is None else active & watch
     tri = tri[(active[np.maximum(of[tri], 0)] & (of[tri] >= 0)).any(axis=1)]
