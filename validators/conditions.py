@@ -224,6 +224,20 @@ def _geodesic_lengths(pts, edges, tv, tf, vertex_of) -> np.ndarray:
     return length
 
 
+def _unique_rows(a: np.ndarray, return_counts: bool = False):
+    """``np.unique(a, axis=0)`` for non-negative int rows, by one int64 key
+    per row (same result and order, a 1-D sort instead of a lexicographic one)."""
+    a = np.asarray(a, dtype=np.int64)
+    base = int(a.max()) + 1 if a.size else 1
+    if base ** a.shape[1] >= 2**62:
+        return np.unique(a, axis=0, return_counts=return_counts)
+    key = np.zeros(a.shape[0], dtype=np.int64)
+    for col in range(a.shape[1]):
+        key = key * base + a[:, col]
+    _, first, counts = np.unique(key, return_index=True, return_counts=True)
+    return (a[first], counts) if return_counts else a[first]
+
+
 def _patch_sets(tv: np.ndarray, tf: np.ndarray, degrees: float) -> np.ndarray:
     """Per truth vertex, the smooth patches it lies on, padded with -1 (m, K).
 
@@ -240,7 +254,7 @@ def _patch_sets(tv: np.ndarray, tf: np.ndarray, degrees: float) -> np.ndarray:
     smooth = cos >= np.cos(np.radians(degrees))
     adj = sparse.coo_matrix((np.ones(int(smooth.sum())), (fa[smooth], fb[smooth])), shape=(nt, nt))
     _, patch = csgraph.connected_components(adj, directed=False)
-    pairs = np.unique(np.stack([tf.ravel(), np.repeat(patch, 3)], axis=1), axis=0)
+    pairs = _unique_rows(np.stack([tf.ravel(), np.repeat(patch, 3)], axis=1))
     counts = np.bincount(pairs[:, 0], minlength=tv.shape[0])
     width = max(1, int(counts.max()))
     out = np.full((tv.shape[0], width), -1, dtype=np.int64)
@@ -311,6 +325,108 @@ def _nearest_sample(tv, e, w, snap, pts, patches, max_sweeps: int = 500):
     return label
 
 
+def _labelled_delaunay(tv, tf, snap, pts, sharp_degrees):
+    """DT_M from the nearest-sample labels of the truth's vertices.
+
+    Returns the DT_M edges (sorted pairs), per edge the number of truth edges
+    joining its two cells (the length of its dual Voronoi edge, in mesh edges)
+    and the DT_M triangles (sorted triples).
+    """
+    e = np.concatenate([tf[:, [0, 1]], tf[:, [1, 2]], tf[:, [2, 0]]])
+    e = _unique_rows(np.sort(e, axis=1))
+    w = np.linalg.norm(tv[e[:, 0]] - tv[e[:, 1]], axis=1)
+    label_of_vertex = _nearest_sample(tv, e, w, snap, pts, _patch_sets(tv, tf, sharp_degrees))
+    la, lb = label_of_vertex[e[:, 0]], label_of_vertex[e[:, 1]]
+    diff = (la != lb) & (la >= 0) & (lb >= 0)
+    pairs = np.sort(np.stack([la[diff], lb[diff]], axis=1), axis=1).reshape(-1, 2)
+    dt_edges, crossings = _unique_rows(pairs, return_counts=True)
+    lt = label_of_vertex[tf]
+    three = (lt[:, 0] != lt[:, 1]) & (lt[:, 1] != lt[:, 2]) & (lt[:, 0] != lt[:, 2])
+    dt_tri = _unique_rows(np.sort(lt[three], axis=1).reshape(-1, 3))
+    return dt_edges.reshape(-1, 2), crossings, dt_tri
+
+
+# a DT_M edge whose two cells meet along at most this many truth edges (at the
+# default resolution, a fifth of the spacing) is a near tie: its four samples
+# lie within about the resolution of one circle, so the labels may have taken
+# the wrong diagonal
+TIE_CROSSINGS = 6
+
+
+def _quads(tri: np.ndarray, edges: np.ndarray, n: int) -> np.ndarray:
+    """Rows (a, b, c, d): an edge (a, b) of ``edges`` and the corners c, d of
+    its two triangles in ``tri``; edges on other than two triangles are left out."""
+    sides = np.sort(np.stack([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]], 1), 2)
+    key = (sides[..., 0] * n + sides[..., 1]).ravel()
+    corner = tri[:, [2, 0, 1]].ravel()
+    on = np.isin(key, edges[:, 0] * n + edges[:, 1])
+    key, corner = key[on], corner[on]
+    order = np.lexsort((corner, key))
+    key, corner = key[order], corner[order]
+    edge, first, count = np.unique(key, return_index=True, return_counts=True)
+    two = count == 2
+    e, f = edge[two], first[two]
+    return np.stack([e // n, e % n, corner[f], corner[f + 1]], axis=1)
+
+
+def _angle(x, y, z) -> np.ndarray:
+    """Angle opposite the side z of the flat triangle with sides x, y, z."""
+    return np.arccos(np.clip((x * x + y * y - z * z) / (2.0 * x * y), -1.0, 1.0))
+
+
+def _flip_near_ties(pts, dt, tv, tf, snap, rounds: int = 4):
+    """Decide the near ties of DT_M by the intrinsic Delaunay criterion.
+
+    For each near-tie edge (a, b) (:data:`TIE_CROSSINGS`) with triangles
+    (a, b, c) and (a, b, d), the angles at c and d come from the geodesic
+    lengths of the five pairs (each triangle developed flat); when they sum
+    to more than π the edge is not locally Delaunay and is flipped to (c, d)
+    (Lawson's flip; a triangle takes part in one flip a round).  On a flat
+    face, and across a straight sharp edge (which develops flat), this is
+    exact whatever the resolution of the labels.  A sum within 1e-9 of π
+    (truly cocircular samples) keeps the labelled diagonal.
+    """
+    n = pts.shape[0]
+    edges, cross, tri = dt
+    for _ in range(rounds):
+        q = _quads(tri, edges[cross <= TIE_CROSSINGS], n) if tri.size else np.empty((0, 4))
+        if q.size == 0:
+            break
+        pairs = np.sort(
+            np.concatenate([q[:, [0, 1]], q[:, [0, 2]], q[:, [1, 2]], q[:, [0, 3]], q[:, [1, 3]]]),
+            axis=1,
+        )
+        uniq, inv = np.unique(pairs, axis=0, return_inverse=True)
+        ab, ac, bc, ad, bd = _geodesic_lengths(pts, uniq, tv, tf, snap)[inv.ravel()].reshape(5, -1)
+        flips = q[_angle(ac, bc, ab) + _angle(ad, bd, ab) > np.pi + 1e-9]
+        if flips.size == 0:
+            break
+        old = [np.sort(flips[:, [0, 1, 2]], axis=1), np.sort(flips[:, [0, 1, 3]], axis=1)]
+        code = [(t[:, 0] * n + t[:, 1]) * n + t[:, 2] for t in old]
+        taken: set[int] = set()
+        use = np.zeros(len(flips), dtype=bool)
+        for i, (k1, k2) in enumerate(zip(code[0].tolist(), code[1].tolist())):
+            if k1 not in taken and k2 not in taken:
+                use[i] = True
+                taken.update((k1, k2))
+        a, b, c, d = flips[use].T
+        tcode = (tri[:, 0] * n + tri[:, 1]) * n + tri[:, 2]
+        tri = np.concatenate(
+            [
+                tri[~np.isin(tcode, list(taken))],
+                np.sort(np.concatenate([np.stack([a, c, d], 1), np.stack([b, c, d], 1)]), axis=1),
+            ]
+        )
+        tri = _unique_rows(tri)
+        gone = np.isin(edges[:, 0] * n + edges[:, 1], np.minimum(a, b) * n + np.maximum(a, b))
+        new = np.sort(np.stack([c, d], 1), axis=1)
+        edges = np.concatenate([edges[~gone], new])
+        cross = np.concatenate([cross[~gone], np.zeros(len(new), dtype=cross.dtype)])
+        order = np.lexsort((edges[:, 1], edges[:, 0]))
+        edges, cross = edges[order], cross[order]
+    return edges, cross, tri
+
+
 def sample_conditions(
     points,
     truth_vertices,
@@ -318,6 +434,7 @@ def sample_conditions(
     *,
     sharp_degrees: float = 30.0,
     resolution: float | None = None,
+    flip_ties: bool = True,
 ):
     """Measure Conditions II-ii, III-i and III-ii with geodesics on the truth.
 
@@ -344,6 +461,10 @@ def sample_conditions(
     resolution : float, optional
         Longest truth edge after refinement; default a fifth of the samples'
         median nearest-neighbour distance.
+    flip_ties : bool
+        Decide near ties (four samples within about the resolution of one
+        circle) by the intrinsic Delaunay angle test on geodesic lengths
+        (:func:`_flip_near_ties`) instead of by the labels alone.
 
     Returns
     -------
@@ -364,16 +485,11 @@ def sample_conditions(
     genus = tuple(c.genus for c in signature(of, ov.shape[0]).components)
     tv, tf = refine_to_edge_length(ov, of, resolution)
     tv, tf, snap = insert_points(tv, tf, pts)
-    e = np.concatenate([tf[:, [0, 1]], tf[:, [1, 2]], tf[:, [2, 0]]])
-    e = np.unique(np.sort(e, axis=1), axis=0)
-    w = np.linalg.norm(tv[e[:, 0]] - tv[e[:, 1]], axis=1)
-    label_of_vertex = _nearest_sample(tv, e, w, snap, pts, _patch_sets(tv, tf, sharp_degrees))
-    la, lb = label_of_vertex[e[:, 0]], label_of_vertex[e[:, 1]]
-    diff = (la != lb) & (la >= 0) & (lb >= 0)
-    dt_edges = np.unique(np.sort(np.stack([la[diff], lb[diff]], axis=1), axis=1), axis=0)
-    lt = label_of_vertex[tf]
-    three = (lt[:, 0] != lt[:, 1]) & (lt[:, 1] != lt[:, 2]) & (lt[:, 0] != lt[:, 2])
-    dt_tri = np.unique(np.sort(lt[three], axis=1), axis=0)
+    dt_edges, crossings, dt_tri = _labelled_delaunay(tv, tf, snap, pts, sharp_degrees)
+    if flip_ties:
+        dt_edges, crossings, dt_tri = _flip_near_ties(
+            pts, (dt_edges, crossings, dt_tri), tv, tf, snap
+        )
     length = _geodesic_lengths(pts, dt_edges, tv, tf, snap)
     key = dt_edges[:, 0] * n + dt_edges[:, 1]
     order = np.argsort(key)
