@@ -195,33 +195,50 @@ class ConditionReport:
         ]
 
 
-def _geodesic_lengths(pts, edges, tv, tf, vertex_of) -> np.ndarray:
-    """Geodesic length on the truth mesh of each sample pair in ``edges``.
+class _Geodesics:
+    """Geodesic lengths on the truth mesh between samples, each pair computed once.
 
     A pair whose chord lies on the surface (both samples on one flat face, or
     on one ruling) has the chord as its geodesic: nothing on the surface is
-    shorter.  The others are traced by potpourri3d's edge-flip solver between
-    the truth vertices that are the samples.
+    shorter.  The others are traced by potpourri3d's edge-flip solver (built
+    once, on first need) between the truth vertices that are the samples.
     """
-    import potpourri3d as pp3d
 
-    from .fidelity import distance_to_surface
+    def __init__(self, pts, tv, tf, vertex_of):
+        self.pts, self.tv, self.tf, self.vertex_of = pts, tv, tf, vertex_of
+        self._solver = None
+        self._known: dict[int, float] = {}
 
-    a, b = pts[edges[:, 0]], pts[edges[:, 1]]
-    chord = np.linalg.norm(a - b, axis=1)
-    s = np.array([0.2, 0.4, 0.6, 0.8])
-    probe = (a[:, None] * (1 - s)[None, :, None] + b[:, None] * s[None, :, None]).reshape(-1, 3)
-    off = distance_to_surface(probe, tv, tf).reshape(-1, s.size).max(axis=1)
-    length = chord.copy()
-    curved = np.flatnonzero(off > 1e-9 * np.maximum(chord, 1e-300) + 1e-12)
-    if curved.size:
-        solver = pp3d.EdgeFlipGeodesicSolver(tv, tf)
+    def __call__(self, pairs: np.ndarray) -> np.ndarray:
+        """Lengths of the sample pairs ``pairs`` ((m, 2) int, each row sorted)."""
+        n = self.pts.shape[0]
+        code = pairs[:, 0] * n + pairs[:, 1]
+        todo = np.unique(code[[c not in self._known for c in code.tolist()]])
+        if todo.size:
+            got = self._compute(np.stack([todo // n, todo % n], axis=1))
+            self._known.update(zip(todo.tolist(), got.tolist()))
+        return np.array([self._known[c] for c in code.tolist()], dtype=np.float64)
+
+    def _compute(self, edges: np.ndarray) -> np.ndarray:
+        import potpourri3d as pp3d
+
+        from .fidelity import distance_to_surface
+
+        a, b = self.pts[edges[:, 0]], self.pts[edges[:, 1]]
+        chord = np.linalg.norm(a - b, axis=1)
+        s = np.array([0.2, 0.4, 0.6, 0.8])
+        probe = (a[:, None] * (1 - s)[None, :, None] + b[:, None] * s[None, :, None]).reshape(-1, 3)
+        off = distance_to_surface(probe, self.tv, self.tf).reshape(-1, s.size).max(axis=1)
+        length = chord.copy()
+        curved = np.flatnonzero(off > 1e-9 * np.maximum(chord, 1e-300) + 1e-12)
+        if curved.size and self._solver is None:
+            self._solver = pp3d.EdgeFlipGeodesicSolver(self.tv, self.tf)
         for i in curved.tolist():
-            path = solver.find_geodesic_path(
-                int(vertex_of[edges[i, 0]]), int(vertex_of[edges[i, 1]])
+            path = self._solver.find_geodesic_path(
+                int(self.vertex_of[edges[i, 0]]), int(self.vertex_of[edges[i, 1]])
             )
             length[i] = max(float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum()), chord[i])
-    return length
+        return length
 
 
 def _unique_rows(a: np.ndarray, return_counts: bool = False):
@@ -374,7 +391,7 @@ def _angle(x, y, z) -> np.ndarray:
     return np.arccos(np.clip((x * x + y * y - z * z) / (2.0 * x * y), -1.0, 1.0))
 
 
-def _flip_near_ties(pts, dt, tv, tf, snap, rounds: int = 4):
+def _flip_near_ties(pts, dt, geodesics: _Geodesics, rounds: int = 4):
     """Decide the near ties of DT_M by the intrinsic Delaunay criterion.
 
     For each near-tie edge (a, b) (:data:`TIE_CROSSINGS`) with triangles
@@ -396,8 +413,7 @@ def _flip_near_ties(pts, dt, tv, tf, snap, rounds: int = 4):
             np.concatenate([q[:, [0, 1]], q[:, [0, 2]], q[:, [1, 2]], q[:, [0, 3]], q[:, [1, 3]]]),
             axis=1,
         )
-        uniq, inv = np.unique(pairs, axis=0, return_inverse=True)
-        ab, ac, bc, ad, bd = _geodesic_lengths(pts, uniq, tv, tf, snap)[inv.ravel()].reshape(5, -1)
+        ab, ac, bc, ad, bd = geodesics(pairs).reshape(5, -1)
         flips = q[_angle(ac, bc, ab) + _angle(ad, bd, ab) > np.pi + 1e-9]
         if flips.size == 0:
             break
@@ -486,11 +502,11 @@ def sample_conditions(
     tv, tf = refine_to_edge_length(ov, of, resolution)
     tv, tf, snap = insert_points(tv, tf, pts)
     dt_edges, crossings, dt_tri = _labelled_delaunay(tv, tf, snap, pts, sharp_degrees)
+    geodesics = _Geodesics(pts, tv, tf, snap)
     if flip_ties:
-        dt_edges, crossings, dt_tri = _flip_near_ties(
-            pts, (dt_edges, crossings, dt_tri), tv, tf, snap
-        )
-    length = _geodesic_lengths(pts, dt_edges, tv, tf, snap)
+        geodesics(dt_edges)  # every DT_M edge's length, in one pass
+        dt_edges, crossings, dt_tri = _flip_near_ties(pts, (dt_edges, crossings, dt_tri), geodesics)
+    length = geodesics(dt_edges)
     key = dt_edges[:, 0] * n + dt_edges[:, 1]
     order = np.argsort(key)
 
