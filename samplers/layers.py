@@ -30,7 +30,7 @@ from scipy.spatial import Delaunay, cKDTree
 from validators.conditions import SQRT3_2
 
 from .adjacency import EdgeFaces
-from .repair import MOVABLE, repair
+from .repair import MOVABLE, repair, rotate
 
 LAYER = 2.5  # samples within this many h of a circular edge may move
 RASTER = 8  # inside tests on a grid of h / RASTER
@@ -673,7 +673,6 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
 
 
 APEX_KEEP = 5.0  # samples this near the apex (times t) stay
-CONE_SEAM = 1.5  # samples this near (times t) the cut of a developed cone stay fixed
 
 
 def _repair_developed(
@@ -681,20 +680,22 @@ def _repair_developed(
 ):
     """Repair a cone's rings where they break Condition III-ii, on the cone's development.
 
-    A cone is isometric to a plane sector of angle ``2 pi sin(a)``: a sample
-    at slant distance ``rho`` and angle ``ang`` about the axis lies at polar
-    coordinates ``(rho, ang sin(a))``, and its intrinsic Delaunay triangles
-    are the sector's.  The sector is cut at angle 0; samples within
-    ``CONE_SEAM`` t of the cut stay, and their images turned by the sector's
-    angle stand across it (fixed, never judged), so the cut needs no
-    periodic repair.  Samples within ``MOVABLE`` t of a triangle that breaks
-    Condition III-ii (where rings halve near the apex, or an odd ring ends
-    its columns unevenly) may move (:func:`samplers.repair.repair`); the
-    rim and samples within ``APEX_KEEP`` t of the apex stay.  Measured:
-    letting every halving move made the cone worse (triangles at 0.83 to
-    0.86, within the condition, were pushed about by the repair's margin:
-    1.9% of the samples violating); letting the apex's neighbourhood move
-    left conebox's reconstruction 12 open edges round its apex.
+    A cone is isometric to a plane sector of angle ``2 pi sin(a)`` whose two
+    sides are glued: a sample at slant distance ``rho`` and angle ``ang``
+    about the axis lies at polar coordinates ``(rho, ang sin(a))``, and its
+    intrinsic Delaunay triangles are the sector's, across the glued sides
+    too (:func:`samplers.repair.repair` with ``turn``).  Samples within
+    ``MOVABLE`` t of a triangle that breaks Condition III-ii (where rings
+    halve, or an odd ring ends its columns unevenly, or at the glued sides)
+    may move; the rim and samples within ``APEX_KEEP`` t of the apex stay.
+    Measured: letting every halving move made the cone worse (triangles at
+    0.83 to 0.86, within the condition, were pushed about by the repair's
+    margin: 1.9% of the samples violating); letting the apex's
+    neighbourhood move mends it on the development but thins it out, and
+    the reconstruction then opens round the apex (8 to 15 open edges on the
+    cone).  Before the sides were glued, samples within 1.5 t of the cut
+    stayed and their images stood across it, fixed and never judged (cone
+    0.43% of the samples violating, now 0.30%).
     With ``sin_a`` 1 the development is a disk with no cut (a smooth
     pole's neighbourhood, mapped by distance and angle about it), and
     ``apex_keep`` (times t) sets the fixed neighbourhood of the apex.
@@ -708,25 +709,16 @@ def _repair_developed(
     rim_psi = rim_ang * sin_a
     rim = slant * np.stack([np.cos(rim_psi), np.sin(rim_psi)], axis=1)
     allp = np.vstack([uv, rim, np.zeros((1, 2))])
-    allpsi = np.r_[psi, rim_psi, 0.0]
-    allrho = np.r_[rho, np.full(rim.shape[0], slant), 0.0]
-    # images across the cut: samples near either side turned by -theta or +theta
-    frame = [np.empty((0, 2))]
-    reach = 3 * t / np.maximum(allrho, t)
-    for sign, side in () if full else ((1.0, allpsi < reach), (-1.0, allpsi > theta - reach)):
-        side &= allrho > 0  # not the apex
-        a = allpsi[side] + sign * theta
-        frame.append(allrho[side][:, None] * np.stack([np.cos(a), np.sin(a)], axis=1))
 
     def inside(c: np.ndarray) -> np.ndarray:
         r = np.linalg.norm(c, axis=1)
         a = np.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
-        return (r < slant) & (full | ((a > 0) & (a < theta)))
+        return (r < slant) & (full | (a < theta))
 
     n = uv.shape[0]
-    frame = np.vstack(frame)
-    # where the rings break Condition III-ii: the triangles to mend
-    pts = np.vstack([allp, frame])
+    # where the rings break Condition III-ii: the triangles to mend (across the
+    # cut too: every sample's images turned by the sector's angle either way)
+    pts = allp if full else np.vstack([allp] + [rotate(allp, sign * theta) for sign in (1, -1)])
     tri = Delaunay(pts).simplices
     tri = tri[inside(pts[tri].mean(axis=1))]
     side = np.sort(np.linalg.norm(pts[tri] - pts[np.roll(tri, 1, axis=1)], axis=2), axis=1)
@@ -734,15 +726,21 @@ def _repair_developed(
     near = np.zeros(n, dtype=bool)
     if broken.shape[0]:
         near = cKDTree(broken).query(uv)[0] <= MOVABLE * t
-    # distance to the cut, either side (along the arc, the sector's angle from 0 and from theta)
-    arc = np.minimum(psi, theta - psi) * rho
-    free = near & (full | (arc > CONE_SEAM * t)) & (rho > apex_keep * t)
+        if not full:
+            for sign in (1, -1):
+                near |= cKDTree(broken).query(rotate(uv, sign * theta))[0] <= MOVABLE * t
+    free = near & (rho > apex_keep * t)
     if not free.any():
         return rho, ang, row, 0, 0.0
     fixed_free = np.r_[free, np.zeros(rim.shape[0] + 1, dtype=bool)]
 
     out = repair(
-        allp, fixed_free, t, inside=inside, clamp=_radial_clamp(0.0, slant - 0.25 * t), frame=frame
+        allp,
+        fixed_free,
+        t,
+        inside=inside,
+        clamp=_radial_clamp(0.0, slant - 0.25 * t),
+        turn=None if full else theta,
     )
     mine = out.origin < n  # not the rim nor the apex
     uv2 = out.uv[mine]

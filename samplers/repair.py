@@ -41,6 +41,7 @@ STEP = 0.02  # largest move per descent step, times h
 SEPARATION = 12.0  # bad triangles edited at once are this far apart, times h
 MOVABLE = 3.0  # a layout's samples this near (times h) a defect it repairs may move
 REACH = 4.0  # in a local descent, triangles with a longer edge (times h) join two regions
+IMAGE_BAND = 4.0  # samples this near (times h) a glued side of a development get an image
 _EDGES = np.array([[0, 1], [1, 2], [2, 0]])
 GHOST, FRAME = -1, -2  # the sample id of a ghost point and of a frame point
 
@@ -67,6 +68,12 @@ class Repaired:
     worst: float
 
 
+def rotate(p: np.ndarray, angle) -> np.ndarray:
+    """Points (k, 2) turned about the origin by ``angle`` (a scalar or one per point)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1]], axis=1)
+
+
 class _Problem:
     """Samples with their roles and the face's callbacks."""
 
@@ -82,6 +89,7 @@ class _Problem:
         clamp=None,
         frame=None,
         judge_frame=False,
+        turn=None,
     ):
         self.uv = np.asarray(uv, dtype=np.float64).copy()
         self.free = np.asarray(free, dtype=bool).copy()
@@ -94,6 +102,7 @@ class _Problem:
         self.clamp = clamp
         self.frame = np.empty((0, 2)) if frame is None else np.asarray(frame, dtype=np.float64)
         self.frame_id = FRAME if judge_frame else GHOST
+        self.turn = turn
         self._watch: np.ndarray | None = None
 
     def watch(self) -> np.ndarray:
@@ -115,9 +124,47 @@ class _Problem:
         move = self.free | self.slide
         out = move.copy()
         if move.any() and (~move).any():
-            d, _ = cKDTree(self.uv[move]).query(self.uv[~move])
+            pos, _, _ = self.images(np.flatnonzero(move))
+            d, _ = cKDTree(np.vstack([self.uv[move], pos])).query(self.uv[~move])
             out[~move] = d < 1.5 * self.h
         return out
+
+    def images(self, idx: np.ndarray):
+        """Copies of the samples ``idx`` across the glued sides of a cone's
+        development (none without ``turn``): a sample within ``IMAGE_BAND`` h
+        (along its arc) of the side at angle 0 turned by ``+turn``, one near
+        the side at ``turn`` by ``-turn``.  Returns their positions, the
+        samples they are and the angle each is turned by."""
+        if self.turn is None or idx.size == 0:
+            return np.empty((0, 2)), np.empty(0, dtype=np.int64), np.empty(0)
+        p = self.uv[idx]
+        r = np.linalg.norm(p, axis=1)
+        a = np.arctan2(p[:, 1], p[:, 0]) % (2 * np.pi)
+        band = IMAGE_BAND * self.h
+        out, of, angle = [], [], []
+        for sign, near in ((1.0, a * r < band), (-1.0, (self.turn - a) * r < band)):
+            out.append(rotate(p[near], sign * self.turn))
+            of.append(idx[near])
+            angle.append(np.full(int(near.sum()), sign * self.turn))
+        return np.vstack(out), np.concatenate(of), np.concatenate(angle)
+
+    def wrap(self, p: np.ndarray) -> np.ndarray:
+        """Positions turned back into the development's sector [0, turn)."""
+        if self.turn is None or p.shape[0] == 0:
+            return p
+        a = np.arctan2(p[:, 1], p[:, 0]) % (2 * np.pi)
+        k = np.where(a >= self.turn, np.where(a >= 0.5 * (self.turn + 2 * np.pi), 1.0, -1.0), 0.0)
+        return rotate(p, k * self.turn)
+
+    def distance(self, centre: np.ndarray) -> np.ndarray:
+        """Distance of every sample to ``centre``, across the glued sides too."""
+        d = np.linalg.norm(self.uv - centre, axis=1)
+        if self.turn is not None:
+            for sign in (1.0, -1.0):
+                d = np.minimum(
+                    d, np.linalg.norm(rotate(self.uv, sign * self.turn) - centre, axis=1)
+                )
+        return d
 
     def copy(self) -> _Problem:
         c = _Problem.__new__(_Problem)
@@ -132,11 +179,14 @@ class _Problem:
         return c
 
     def extended(self, subset=None):
-        """Points (with the ghosts, standing for sample -1, and the frame, -2
-        when its triangles are judged, else -1) and the sample each is."""
+        """Points (with the images across a development's glued sides, the
+        ghosts, standing for sample -1, and the frame, -2 when its triangles
+        are judged, else -1), the sample each is and the angle each image is
+        turned by (0 for the others)."""
         idx = np.arange(self.uv.shape[0]) if subset is None else subset
-        pts = self.uv[idx]
-        of = idx
+        img, img_of, img_angle = self.images(idx)
+        pts = np.vstack([self.uv[idx], img])
+        of = np.concatenate([idx, img_of])
         if self.ghosts is not None:
             g = self.ghosts(self.uv[idx[self.slide[idx]]])
             pts = np.vstack([pts, g])
@@ -147,30 +197,33 @@ class _Problem:
             f = self.frame[((self.frame >= lo) & (self.frame <= hi)).all(axis=1)]
             pts = np.vstack([pts, f])
             of = np.concatenate([of, np.full(f.shape[0], self.frame_id)])
-        return pts, of
+        turned = np.zeros(pts.shape[0])
+        turned[idx.size : idx.size + img_angle.size] = img_angle
+        return pts, of, turned
 
 
 def _triangles(prob: _Problem, subset=None):
-    pts, of = prob.extended(subset)
+    pts, of, turned = prob.extended(subset)
     if pts.shape[0] < 3:
-        return pts, of, np.empty((0, 3), dtype=np.int64)
+        return pts, of, turned, np.empty((0, 3), dtype=np.int64)
     try:
         tri = Delaunay(pts).simplices
     except QhullError:
-        return pts, of, np.empty((0, 3), dtype=np.int64)
+        return pts, of, turned, np.empty((0, 3), dtype=np.int64)
     # a triangle across a straight edge (on the frame) is judged with the face's
     # own: its geodesic is the straight line of the unfolding
     keep = prob.inside(pts[tri].mean(axis=1)) | (of[tri] == FRAME).any(axis=1)
-    return pts, of, tri[keep]
+    return pts, of, turned, tri[keep]
 
 
 def _energy(prob: _Problem, subset=None, active=None):
-    """Energy, its gradient on the samples, the ratios and triangles (as sample ids)."""
-    pts, of, tri = _triangles(prob, subset)
+    """Energy, its gradient on the samples, the ratios, the triangles (as
+    sample ids) and their corners' positions."""
+    pts, of, turned, tri = _triangles(prob, subset)
     h = prob.h
     grad = np.zeros_like(prob.uv)
     if tri.shape[0] == 0:
-        return 0.0, grad, np.empty(0), tri
+        return 0.0, grad, np.empty(0), tri, pts[tri]
     # triangles on a ghost are not the face's; those on the frame are, when they
     # have a movable sample (the rest of the frame's cannot change)
     kind = of[tri]
@@ -187,7 +240,7 @@ def _energy(prob: _Problem, subset=None, active=None):
         near = length.max(axis=1) <= REACH * h
         tri, p, vec, length = tri[near], p[near], vec[near], length[near]
     if tri.shape[0] == 0:
-        return 0.0, grad, np.empty(0), tri
+        return 0.0, grad, np.empty(0), tri, p
     order = np.argsort(length, axis=1)
     rows = np.arange(tri.shape[0])
     i2, i3 = order[:, 1], order[:, 2]
@@ -243,9 +296,11 @@ def _energy(prob: _Problem, subset=None, active=None):
     )
     np.add.at(gp, tri.ravel(), pull.reshape(-1, 2))
     real = of >= 0
+    if prob.turn is not None:  # an image's gradient, turned back onto its sample
+        gp = rotate(gp, -turned)
     np.add.at(grad, of[real], gp[real])
     grad[~(prob.free | prob.slide)] = 0.0
-    return energy, grad, rho, of[tri]
+    return energy, grad, rho, of[tri], p
 
 
 def _descend(prob: _Problem, steps: int, subset=None, active=None, centres=None) -> None:
@@ -266,7 +321,7 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
         _, label = cKDTree(np.asarray(centres)).query(prob.uv)
     best, since = np.inf, 0
     for _ in range(steps):
-        energy, grad, rho, _ = _energy(prob, subset, active)
+        energy, grad, rho, _, _ = _energy(prob, subset, active)
         if rho.size == 0 or rho.max() < TARGET + 0.02:
             return
         # stop when the energy has not dropped by 1% in 15 steps
@@ -291,17 +346,22 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
             prob.uv[prob.slide] = prob.project(prob.uv[prob.slide])
         if prob.clamp is not None and prob.free.any():
             prob.uv[prob.free] = prob.clamp(prob.uv[prob.free])
+        if prob.turn is not None:
+            prob.uv[move] = prob.wrap(prob.uv[move])
 
 
 def _status(prob: _Problem, subset=None, active=None):
-    energy, _, rho, tri = _energy(prob, subset, active)
-    bad = tri[rho > BAD] if rho.size else tri[:0]
-    return int(bad.shape[0]), energy, bad, (float(rho.max()) if rho.size else 0.0)
+    """Bad triangles (above ``BAD``): their count, the energy, the triangles
+    (sample ids) with their corners' positions, and the worst ratio."""
+    energy, _, rho, tri, corners = _energy(prob, subset, active)
+    over = rho > BAD if rho.size else np.zeros(0, dtype=bool)
+    bad = (tri[over], corners[over])
+    return int(over.sum()), energy, bad, (float(rho.max()) if rho.size else 0.0)
 
 
 def _local(prob: _Problem, centre: np.ndarray, radius: float):
     """Samples within ``radius`` of ``centre`` and those whose triangles are judged."""
-    r = np.linalg.norm(prob.uv - centre, axis=1)
+    r = prob.distance(centre)
     subset = np.flatnonzero(r < radius)
     active = np.zeros(prob.uv.shape[0], dtype=bool)
     active[r < radius - 1.5 * prob.h] = True
@@ -320,6 +380,7 @@ def repair(
     clamp: Callable[[np.ndarray], np.ndarray] | None = None,
     frame=None,
     judge_frame: bool = False,
+    turn: float | None = None,
     descent_steps: int = 300,
     max_edits: int | None = None,
 ) -> Repaired:
@@ -360,6 +421,13 @@ def repair(
         geodesic edges unfold straight across a polyhedral edge, whose
         samples may then slide).  Not where the frame holds images of the
         face's own samples, which may move while their images do not.
+    turn : float, optional
+        The domain is a cone's development: the sector of this angle about
+        the origin whose two sides are glued (turning by ``turn`` takes the
+        side at angle 0 onto the other).  Samples keep angles in
+        ``[0, turn)``; those near a side have moving images across the other
+        (their gradients turned back), so that the cone's triangles across
+        its cut, and round its apex, are judged and mended like the others.
     descent_steps, max_edits : int
         Work limits (``max_edits`` defaults to an eighth of the movable
         samples, at least 80).
@@ -389,7 +457,10 @@ def repair(
     # work on the movable samples and a frame of fixed ones around them
     tree = cKDTree(uv)
     near = np.zeros(n, dtype=bool)
-    for group in tree.query_ball_point(uv[movable], 3.0 * h):
+    reach = [uv[movable]]
+    if turn is not None:  # and the samples across the glued sides
+        reach += [rotate(uv[movable], sign * turn) for sign in (1.0, -1.0)]
+    for group in tree.query_ball_point(np.vstack(reach), 3.0 * h):
         near[group] = True
     sub = np.flatnonzero(near | movable)
     prob = _Problem(
@@ -403,6 +474,7 @@ def repair(
         clamp,
         frame,
         judge_frame,
+        turn,
     )
     _descend(prob, descent_steps)
     nbad, _, bad, worst = _status(prob)
@@ -449,7 +521,7 @@ def _edited(prob: _Problem, edits) -> _Problem:
     keep = np.ones(trial.uv.shape[0], dtype=bool)
     keep[[arg for kind, arg in edits if kind == "del"]] = False
     add = [np.asarray(arg, dtype=np.float64) for kind, arg in edits if kind == "add"]
-    trial.uv = np.vstack([trial.uv[keep], *[a[None] for a in add]])
+    trial.uv = np.vstack([trial.uv[keep], *[trial.wrap(a[None]) for a in add]])
     trial.free = np.r_[trial.free[keep], np.ones(len(add), dtype=bool)]
     trial.slide = np.r_[trial.slide[keep], np.zeros(len(add), dtype=bool)]
     trial.origin = np.r_[trial.origin[keep], np.full(len(add), -1)]
@@ -471,14 +543,13 @@ def _key(centre: np.ndarray) -> tuple:
     return tuple(np.round(centre, 9).tolist())
 
 
-def _regions(prob: _Problem, bad: np.ndarray, skip: set) -> list[tuple[np.ndarray, np.ndarray]]:
+def _regions(prob: _Problem, bad, skip: set) -> list[tuple[np.ndarray, np.ndarray]]:
     """Bad triangles to edit at once: in order of their centres (x, then y),
     skipping those already found stuck, each at least ``SEPARATION`` h from
     the ones taken before it, so that their edits do not interact."""
+    bad, corners = bad
     real = bad >= 0  # a frame point is no sample: the centre is that of the real corners
-    centres = (prob.uv[np.maximum(bad, 0)] * real[..., None]).sum(axis=1) / real.sum(axis=1)[
-        :, None
-    ]
+    centres = prob.wrap((corners * real[..., None]).sum(axis=1) / real.sum(axis=1)[:, None])
     order = np.lexsort((centres[:, 1], centres[:, 0]))
     taken: list[int] = []
     for i in order.tolist():
