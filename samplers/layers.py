@@ -640,6 +640,15 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
             rho_l.append(np.full(ang.size, rho))
             ang_l.append(ang)
             row_l.append(np.full(ang.size, j - 1))
+        keep = APEX_KEEP
+        fan = _apex_fan(2 * math.pi * sin_a) if rho_l else None
+        if fan is not None:  # the ring round the apex becomes the designed fan
+            r1 = rho_l[-1][0]
+            m = fan.size
+            rho_l[-1] = r1 * fan
+            ang_l[-1] = (ang_l[-1][0] + 2 * math.pi * np.arange(m) / m) % (2 * math.pi)
+            row_l[-1] = np.full(m, row_l[-1][0])
+            keep = FAN_KEEP * r1 / t
         nrows = len(rho_l)
         rho_a = np.concatenate(rho_l) if rho_l else np.empty(0)
         ang_a = np.concatenate(ang_l) if ang_l else np.empty(0)
@@ -647,7 +656,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         bad = worst = None
         if rho_a.size:
             rho_a, ang_a, row_a, bad, worst = _repair_developed(
-                rho_a, ang_a, row_a, rim_ang, slant, sin_a, t
+                rho_a, ang_a, row_a, rim_ang, slant, sin_a, t, keep
             )
         z = rho_a * math.cos(abs(cone.SemiAngle()))
         rr = rho_a * sin_a
@@ -673,6 +682,60 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
 
 
 APEX_KEEP = 5.0  # samples this near the apex (times t) stay
+FAN_KEEP = 1.3  # ... or, round a designed fan, this near (times the fan's radius)
+FAN_RATIO = 0.85  # a fan's triangles keep their ratio (Condition III-ii) below this
+FAN_ANGLES = 165.0  # ... and its spokes' opposite angles below this sum (degrees)
+
+
+def _fan_figures(radii: np.ndarray, phi: float):
+    """For fans round an apex, spokes ``radii`` (rows, one fan a row; the
+    first spoke 1) ``phi`` apart on the development: the worst Condition
+    III-ii ratio of their triangles and the largest sum of the two angles
+    opposite a spoke (a spoke is a Delaunay edge while it stays below π)."""
+    a, b = radii, np.roll(radii, -1, axis=1)  # spoke k and spoke k + 1
+    c = np.sqrt(a * a + b * b - 2 * a * b * math.cos(phi))
+    side = np.sort(np.stack([a, b, c], axis=2), axis=2)
+    ratio = (side[..., 1] / side[..., 2]).max(axis=1)
+    # in triangle (apex, k, k + 1): the angle at k + 1 faces spoke k, the one at k faces k + 1
+    at_next = np.arccos(np.clip((b * b + c * c - a * a) / (2 * b * c), -1, 1))
+    at_this = np.arccos(np.clip((a * a + c * c - b * b) / (2 * a * c), -1, 1))
+    opposite = at_next + np.roll(at_this, 1, axis=1)  # both triangles on spoke k
+    return ratio, np.degrees(opposite.max(axis=1))
+
+
+def _apex_fan(theta: float) -> np.ndarray | None:
+    """Spokes round a cone's apex that meet Condition III-ii, or None.
+
+    The ring nearest a cone's apex (``theta``: the development's angle) with
+    m equal spokes makes isosceles triangles: two equal longest sides (a
+    ratio of 1) unless the spokes are more than 70.5° apart.  Spokes of
+    unequal lengths mend that, but only while each spoke stays a Delaunay
+    edge (the two angles facing it sum to less than π).  This searches m =
+    2, 3, 4 equally spaced spokes, the first of length 1 and the others on
+    a grid of 0.40 to 1.00 (step 0.01), for fans whose ratio is below
+    ``FAN_RATIO`` and whose angle sums stay below ``FAN_ANGLES`` (a margin
+    that keeps the check's labels sure of the spokes); of those, 3 or 4
+    spokes before 2 (an apex of degree 2 has two triangles on the same three
+    samples, which no triangle mesh holds: a reconstruction must cone it), the
+    count whose spokes are nearest 90° apart (the lattice's right angles),
+    then the lowest worst ratio.  Returns the spoke lengths, or None when no fan
+    qualifies (developments of about 120° to 126°: no fan of 2, 3 or 4
+    spokes works with that margin).  Deterministic: the first of equal fans
+    in grid order.
+    """
+    grid = np.round(np.arange(0.40, 1.0001, 0.01), 2)
+    best = None
+    for m in (2, 3, 4):
+        rest = np.stack(np.meshgrid(*[grid] * (m - 1), indexing="ij"), -1).reshape(-1, m - 1)
+        radii = np.c_[np.ones(rest.shape[0]), rest]
+        ratio, angles = _fan_figures(radii, theta / m)
+        ok = np.flatnonzero((ratio < FAN_RATIO) & (angles < FAN_ANGLES))
+        if ok.size:
+            i = ok[np.argmin(ratio[ok])]
+            key = (m == 2, round(abs(math.degrees(theta / m) - 90.0), 9), ratio[i])
+            if best is None or key < best[0]:
+                best = (key, radii[i])
+    return None if best is None else best[1]
 
 
 def _repair_developed(

@@ -174,3 +174,32 @@ def test_near_ties_take_the_delaunay_diagonal(rotation, offset, shift):
 
     assert quad_triangles(sample_conditions(p, v, f)) == exact
     assert quad_triangles(sample_conditions(p, v, f, flip_ties=False)) != exact
+
+
+def test_chords_stand_for_geodesics_only_where_the_patch_is_flat_between():
+    """Near a cone's apex two points of its one smooth patch face away from
+    each other: the chord through the solid is far shorter than the geodesic,
+    and labelling by it had a designed apex's Voronoi cell lose its spokes.
+    The chord serves only where the patch's normals at both ends agree."""
+    from validators.conditions import _chord_ok, _patch_sets
+
+    m, rings = 64, 8  # an open cone: apex, then rings of m vertices
+    a = 2 * np.pi * np.arange(m) / m
+    z = np.arange(1, rings + 1) / rings
+    v = np.vstack(
+        [[0.0, 0.0, 0.0]]
+        + [np.c_[0.3 * zz * np.cos(a), 0.3 * zz * np.sin(a), np.full(m, zz)] for zz in z]
+    )
+    j = np.arange(m)
+    f = [np.c_[np.zeros(m, int), 1 + j, 1 + (j + 1) % m]]
+    for r in range(rings - 1):
+        lo, hi = 1 + r * m, 1 + (r + 1) * m
+        f += [
+            np.c_[lo + j, hi + j, hi + (j + 1) % m],
+            np.c_[lo + j, hi + (j + 1) % m, lo + (j + 1) % m],
+        ]
+    f = np.vstack(f)
+    patches = _patch_sets(v, f, 30.0)
+    mid = 1 + 3 * m  # ring 4: a point, the one facing away from it, and its neighbour
+    assert not _chord_ok(patches, np.array([mid]), np.array([mid + m // 2]))[0]
+    assert _chord_ok(patches, np.array([mid]), np.array([mid + 1]))[0]

@@ -255,11 +255,14 @@ def _unique_rows(a: np.ndarray, return_counts: bool = False):
     return (a[first], counts) if return_counts else a[first]
 
 
-def _patch_sets(tv: np.ndarray, tf: np.ndarray, degrees: float) -> np.ndarray:
-    """Per truth vertex, the smooth patches it lies on, padded with -1 (m, K).
+def _patch_sets(tv: np.ndarray, tf: np.ndarray, degrees: float):
+    """Per truth vertex, the smooth patches it lies on and its normal on each.
 
     A patch is a set of triangles joined across edges whose dihedral is
     below ``degrees``; a vertex on a sharp edge lies on every patch round it.
+    Returns the patch ids (m, K), padded with -1, and the vertex's unit
+    normal on each (m, K, 3): the area-weighted mean of its triangles' in
+    that patch.
     """
     from scipy import sparse
     from scipy.sparse import csgraph
@@ -271,19 +274,40 @@ def _patch_sets(tv: np.ndarray, tf: np.ndarray, degrees: float) -> np.ndarray:
     smooth = cos >= np.cos(np.radians(degrees))
     adj = sparse.coo_matrix((np.ones(int(smooth.sum())), (fa[smooth], fb[smooth])), shape=(nt, nt))
     _, patch = csgraph.connected_components(adj, directed=False)
-    pairs = _unique_rows(np.stack([tf.ravel(), np.repeat(patch, 3)], axis=1))
+    corner = np.stack([tf.ravel(), np.repeat(patch, 3)], axis=1)
+    pairs = _unique_rows(corner)
     counts = np.bincount(pairs[:, 0], minlength=tv.shape[0])
     width = max(1, int(counts.max()))
     out = np.full((tv.shape[0], width), -1, dtype=np.int64)
     start = np.cumsum(counts) - counts
-    out[pairs[:, 0], np.arange(pairs.shape[0]) - start[pairs[:, 0]]] = pairs[:, 1]
-    return out
+    slot = np.arange(pairs.shape[0]) - start[pairs[:, 0]]
+    out[pairs[:, 0], slot] = pairs[:, 1]
+    # each triangle corner's slot: the row of its (vertex, patch) pair
+    npatch = int(patch.max()) + 1
+    row = np.searchsorted(pairs[:, 0] * npatch + pairs[:, 1], corner[:, 0] * npatch + corner[:, 1])
+    area_normal = np.cross(tv[tf[:, 1]] - tv[tf[:, 0]], tv[tf[:, 2]] - tv[tf[:, 0]])
+    normal = np.zeros((tv.shape[0], width, 3))
+    np.add.at(normal, (corner[:, 0], slot[row]), np.repeat(area_normal, 3, axis=0))
+    normal /= np.maximum(np.linalg.norm(normal, axis=2, keepdims=True), 1e-300)
+    return out, normal
 
 
-def _share(pa: np.ndarray, pb: np.ndarray) -> np.ndarray:
-    """Row-wise: whether two rows of :func:`_patch_sets` have a patch in common."""
-    eq = (pa[:, :, None] == pb[:, None, :]) & (pa[:, :, None] >= 0)
-    return eq.any(axis=(1, 2))
+# the chord between two points of one smooth patch stands for their geodesic
+# only where the patch's normals at both differ by less than this (degrees):
+# the chord is then short of it by at most (L / R)^2 / 24, 0.5% here
+CHORD_DEGREES = 20.0
+
+
+def _chord_ok(patches, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise: whether truth vertices ``a`` and ``b`` lie on a common smooth
+    patch (:func:`_patch_sets`) whose normals at the two differ by less than
+    :data:`CHORD_DEGREES` (near a cone's apex, or across a thin cylinder, the
+    chord cuts through the solid and is far shorter than the geodesic)."""
+    pid, nrm = patches
+    pa, pb = pid[a], pid[b]
+    same = (pa[:, :, None] == pb[:, None, :]) & (pa[:, :, None] >= 0)
+    cos = np.einsum("ikd,ild->ikl", nrm[a], nrm[b])
+    return (same & (cos >= np.cos(np.radians(CHORD_DEGREES)))).any(axis=(1, 2))
 
 
 def _nearest_sample(tv, e, w, snap, pts, patches, max_sweeps: int = 500):
@@ -295,9 +319,10 @@ def _nearest_sample(tv, e, w, snap, pts, patches, max_sweeps: int = 500):
     moves the Voronoi boundaries and makes false DT_M triangles.  The labels
     are then corrected by sweeps: a vertex takes a neighbour's sample when
     that is nearer, the distance to a sample on a smooth patch the vertex
-    shares being the straight chord (exact on a flat face, within
-    ``(L / R)^2 / 24`` on a curved one), and otherwise the neighbour's
-    distance plus the edge.  Ties go to the lower sample index.
+    shares, with normals within :data:`CHORD_DEGREES` at both, being the
+    straight chord (exact on a flat face, within ``(L / R)^2 / 24`` on a
+    curved one), and otherwise the neighbour's distance plus the edge.  Ties
+    go to the lower sample index.
     """
     from scipy import sparse
     from scipy.sparse import csgraph
@@ -311,7 +336,7 @@ def _nearest_sample(tv, e, w, snap, pts, patches, max_sweeps: int = 500):
     ok = label >= 0
     score = dist.copy()
     chord = np.linalg.norm(tv[ok] - pts[label[ok]], axis=1)
-    shared = _share(patches[ok], patches[snap[label[ok]]])
+    shared = _chord_ok(patches, np.flatnonzero(ok), snap[label[ok]])
     score[ok] = np.where(shared, chord, dist[ok])
     a = np.r_[e[:, 0], e[:, 1]]
     b = np.r_[e[:, 1], e[:, 0]]
@@ -324,7 +349,7 @@ def _nearest_sample(tv, e, w, snap, pts, patches, max_sweeps: int = 500):
         va, vb, cand = a[sel], b[sel], label[b[sel]]
         direct = np.linalg.norm(tv[va] - pts[cand], axis=1)
         via = score[vb] + ww[sel]
-        s = np.where(_share(patches[va], patches[snap[cand]]), direct, via)
+        s = np.where(_chord_ok(patches, va, snap[cand]), direct, via)
         better = s < score[va] - 1e-12 * np.maximum(s, 1e-300)
         tie = (np.abs(s - score[va]) <= 1e-12 * np.maximum(s, 1e-300)) & (cand < label[va])
         take = better | tie
@@ -361,6 +386,48 @@ def _labelled_delaunay(tv, tf, snap, pts, sharp_degrees):
     three = (lt[:, 0] != lt[:, 1]) & (lt[:, 1] != lt[:, 2]) & (lt[:, 0] != lt[:, 2])
     dt_tri = _unique_rows(np.sort(lt[three], axis=1).reshape(-1, 3))
     return dt_edges.reshape(-1, 2), crossings, dt_tri
+
+
+SETTLE = 8  # a cell the labels cannot close is labelled again this many times finer
+
+
+def _settle(pts, tv, tf, snap, orphans, dt, resolution, sharp_degrees):
+    """Label again, ``SETTLE`` times finer, round the samples ``orphans``.
+
+    A sample in no DT_M triangle has a Voronoi cell whose corners are closer
+    together than the resolution (a small cell at a cone's apex, say): its
+    short Voronoi edges fell between the truth's vertices.  The refined truth
+    is cropped to the vertices within 5.5 spacings (median nearest-sample
+    distance) of an orphan, refined ``SETTLE`` times finer and labelled with
+    the samples in it; the DT_M edges and triangles among the samples within
+    1.5 spacings of an orphan (whose cells lie well inside the crop) are
+    replaced by the new ones (their crossing counts scaled back to the first
+    resolution).
+    """
+    from .refine import refine_to_edge_length
+
+    dt_edges, crossings, dt_tri = dt
+    nn, _ = cKDTree(pts).query(pts, 2)
+    spacing = float(np.median(nn[:, 1]))
+    near = cKDTree(pts[orphans])
+    inner = near.query(pts, distance_upper_bound=1.5 * spacing)[0] <= 1.5 * spacing
+    reach = 5.5 * spacing
+    in_crop = near.query(tv, distance_upper_bound=reach)[0] <= reach
+    ct = tf[in_crop[tf].any(axis=1)]
+    used = np.unique(ct)
+    remap = np.full(tv.shape[0], -1, dtype=np.int64)
+    remap[used] = np.arange(used.size)
+    ids = np.flatnonzero(remap[snap] >= 0)
+    rv, rt = refine_to_edge_length(tv[used], remap[ct], resolution / SETTLE)
+    le, lc, lt = _labelled_delaunay(rv, rt, remap[snap[ids]], pts[ids], sharp_degrees)
+    le, lt = ids[le], ids[lt]
+    old_e = inner[dt_edges].all(axis=1)
+    new_e = inner[le].all(axis=1)
+    edges = np.concatenate([dt_edges[~old_e], le[new_e]])
+    cross = np.concatenate([crossings[~old_e], lc[new_e] // SETTLE])
+    order = np.lexsort((edges[:, 1], edges[:, 0]))
+    tri = np.concatenate([dt_tri[~inner[dt_tri].all(axis=1)], lt[inner[lt].all(axis=1)]])
+    return edges[order], cross[order], _unique_rows(np.sort(tri, axis=1).reshape(-1, 3))
 
 
 # a DT_M edge whose two cells meet along at most this many truth edges (at the
@@ -502,6 +569,11 @@ def sample_conditions(
     tv, tf = refine_to_edge_length(ov, of, resolution)
     tv, tf, snap = insert_points(tv, tf, pts)
     dt_edges, crossings, dt_tri = _labelled_delaunay(tv, tf, snap, pts, sharp_degrees)
+    orphans = np.setdiff1d(np.arange(n), dt_tri)
+    if orphans.size and dt_tri.size:
+        dt_edges, crossings, dt_tri = _settle(
+            pts, tv, tf, snap, orphans, (dt_edges, crossings, dt_tri), resolution, sharp_degrees
+        )
     geodesics = _Geodesics(pts, tv, tf, snap)
     if flip_ties:
         geodesics(dt_edges)  # every DT_M edge's length, in one pass
