@@ -525,14 +525,20 @@ def sample_conditions(
     ground-truth mesh: each truth vertex is labelled with its nearest sample
     (multi-source Dijkstra over the mesh edges, scipy.sparse.csgraph, then
     corrected with straight chords on the smooth patches a vertex shares
-    with a sample, :func:`_nearest_sample`), a truth edge between two labels
-    gives a DT_M edge and a truth triangle with three labels a DT_M
-    triangle.  Geodesic lengths of DT_M edges are exact
-    mesh geodesics (potpourri3d's edge-flip solver) between the samples.
-    Before that the truth is refined (:func:`validators.refine.refine_to_edge_length`)
-    until no edge is longer than ``resolution``, and every sample is made a
-    vertex of it (:func:`validators.refine.insert_points`), so that neither
-    a coarse CAD tessellation nor snapping distorts the lengths.
+    with a sample where the patch is flat between them,
+    :func:`_nearest_sample`), a truth edge between two labels gives a DT_M
+    edge and a truth triangle with three labels a DT_M triangle.  Where the
+    labels are not fine enough, two corrections follow: a sample in no
+    triangle (a cell whose corners fell between the truth's vertices) is
+    labelled again finer round it (:func:`_settle`), and a near tie (four
+    samples nearly on one circle) takes the diagonal of the intrinsic
+    Delaunay angle test (:func:`_flip_near_ties`).  Geodesic lengths of
+    DT_M edges are exact mesh geodesics (potpourri3d's edge-flip solver)
+    between the samples.  Before that the truth is refined
+    (:func:`validators.refine.refine_to_edge_length`) until no edge is
+    longer than ``resolution``, and every sample is made a vertex of it
+    (:func:`validators.refine.insert_points`), so that neither a coarse CAD
+    tessellation nor snapping distorts the lengths.
 
     Parameters
     ----------
