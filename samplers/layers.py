@@ -718,10 +718,10 @@ def _apex_fan(theta: float) -> np.ndarray | None:
     spokes before 2 (an apex of degree 2 has two triangles on the same three
     samples, which no triangle mesh holds: a reconstruction must cone it), the
     count whose spokes are nearest 90° apart (the lattice's right angles),
-    then the lowest worst ratio.  Returns the spoke lengths, or None when no fan
-    qualifies (developments of about 120° to 126°: no fan of 2, 3 or 4
-    spokes works with that margin).  Deterministic: the first of equal fans
-    in grid order.
+    then the lowest worst ratio.  Returns the spoke lengths, or None when no
+    fan qualifies with that margin (developments below 83° or from 115° to
+    142°, cone_tip's 126° among them).  Deterministic: the first of equal
+    fans in grid order.
     """
     grid = np.round(np.arange(0.40, 1.0001, 0.01), 2)
     best = None
