@@ -30,7 +30,7 @@ from scipy.spatial import Delaunay, cKDTree
 from validators.conditions import SQRT3_2
 
 from .adjacency import EdgeFaces
-from .repair import MOVABLE, repair, rotate
+from .repair import MOVABLE, copies, repair
 
 LAYER = 2.5  # samples within this many h of a circular edge may move
 RASTER = 8  # inside tests on a grid of h / RASTER
@@ -595,9 +595,11 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     neighbouring columns come closer than 0.75 h along a row, one of them
     ends (the one whose end leaves the narrower merged gap, at most 1.6 h):
     the cells stay near-rectangles, with a pentagon where a column ends.
-    Where those pentagons still break Condition III-ii (near the apex, or
-    where an odd ring ends its columns unevenly) the rings are repaired on
-    the cone's development (:func:`_repair_developed`).
+    The ring round the apex becomes a designed fan of spokes
+    (:func:`_apex_fan`) where one exists for the cone's angle.  Where the
+    pentagons still break Condition III-ii (near the apex, or where an odd
+    ring ends its columns unevenly) the rings are repaired on the cone's
+    development (:func:`_repair_developed`).
     """
     reports = []
     tol = 1e-7 * size
@@ -781,17 +783,16 @@ def _repair_developed(
     n = uv.shape[0]
     # where the rings break Condition III-ii: the triangles to mend (across the
     # cut too: every sample's images turned by the sector's angle either way)
-    pts = allp if full else np.vstack([allp] + [rotate(allp, sign * theta) for sign in (1, -1)])
+    turn = None if full else theta
+    pts = np.vstack(copies(allp, turn))
     tri = Delaunay(pts).simplices
     tri = tri[inside(pts[tri].mean(axis=1))]
     side = np.sort(np.linalg.norm(pts[tri] - pts[np.roll(tri, 1, axis=1)], axis=2), axis=1)
     broken = pts[tri[side[:, 1] >= SQRT3_2 * side[:, 2]]].mean(axis=1)
     near = np.zeros(n, dtype=bool)
     if broken.shape[0]:
-        near = cKDTree(broken).query(uv)[0] <= MOVABLE * t
-        if not full:
-            for sign in (1, -1):
-                near |= cKDTree(broken).query(rotate(uv, sign * theta))[0] <= MOVABLE * t
+        tree = cKDTree(broken)
+        near = np.any([tree.query(q)[0] <= MOVABLE * t for q in copies(uv, turn)], axis=0)
     free = near & (rho > apex_keep * t)
     if not free.any():
         return rho, ang, row, 0, 0.0
@@ -803,7 +804,7 @@ def _repair_developed(
         t,
         inside=inside,
         clamp=_radial_clamp(0.0, slant - 0.25 * t),
-        turn=None if full else theta,
+        turn=turn,
     )
     mine = out.origin < n  # not the rim nor the apex
     uv2 = out.uv[mine]

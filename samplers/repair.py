@@ -74,6 +74,12 @@ def rotate(p: np.ndarray, angle) -> np.ndarray:
     return np.stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1]], axis=1)
 
 
+def copies(p: np.ndarray, turn: float | None) -> list[np.ndarray]:
+    """``p`` and, on a glued development (``turn``, see :func:`repair`), its
+    images turned by ``+turn`` and ``-turn``."""
+    return [p] if turn is None else [p, rotate(p, turn), rotate(p, -turn)]
+
+
 class _Problem:
     """Samples with their roles and the face's callbacks."""
 
@@ -158,13 +164,9 @@ class _Problem:
 
     def distance(self, centre: np.ndarray) -> np.ndarray:
         """Distance of every sample to ``centre``, across the glued sides too."""
-        d = np.linalg.norm(self.uv - centre, axis=1)
-        if self.turn is not None:
-            for sign in (1.0, -1.0):
-                d = np.minimum(
-                    d, np.linalg.norm(rotate(self.uv, sign * self.turn) - centre, axis=1)
-                )
-        return d
+        return np.min(
+            [np.linalg.norm(q - centre, axis=1) for q in copies(self.uv, self.turn)], axis=0
+        )
 
     def copy(self) -> _Problem:
         c = _Problem.__new__(_Problem)
@@ -457,10 +459,8 @@ def repair(
     # work on the movable samples and a frame of fixed ones around them
     tree = cKDTree(uv)
     near = np.zeros(n, dtype=bool)
-    reach = [uv[movable]]
-    if turn is not None:  # and the samples across the glued sides
-        reach += [rotate(uv[movable], sign * turn) for sign in (1.0, -1.0)]
-    for group in tree.query_ball_point(np.vstack(reach), 3.0 * h):
+    # (and those across the glued sides of a development)
+    for group in tree.query_ball_point(np.vstack(copies(uv[movable], turn)), 3.0 * h):
         near[group] = True
     sub = np.flatnonzero(near | movable)
     prob = _Problem(

@@ -427,7 +427,7 @@ def _settle(pts, tv, tf, snap, orphans, dt, resolution, sharp_degrees):
     cross = np.concatenate([crossings[~old_e], lc[new_e] // SETTLE])
     order = np.lexsort((edges[:, 1], edges[:, 0]))
     tri = np.concatenate([dt_tri[~inner[dt_tri].all(axis=1)], lt[inner[lt].all(axis=1)]])
-    return edges[order], cross[order], _unique_rows(np.sort(tri, axis=1).reshape(-1, 3))
+    return edges[order], cross[order], _unique_rows(tri)  # rows stay sorted: ids increase
 
 
 # a DT_M edge whose two cells meet along at most this many truth edges (at the
