@@ -646,10 +646,9 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         fan = _apex_fan(2 * math.pi * sin_a) if rho_l else None
         if fan is not None:  # the ring round the apex becomes the designed fan
             r1 = rho_l[-1][0]
-            m = fan.size
-            rho_l[-1] = r1 * fan
-            ang_l[-1] = (ang_l[-1][0] + 2 * math.pi * np.arange(m) / m) % (2 * math.pi)
-            row_l[-1] = np.full(m, row_l[-1][0])
+            rho_l[-1] = r1 * fan.radii
+            ang_l[-1] = (ang_l[-1][0] + 2 * math.pi * fan.at) % (2 * math.pi)
+            row_l[-1] = np.full(fan.radii.size, row_l[-1][0])
             keep = FAN_KEEP * r1 / t
         nrows = len(rho_l)
         rho_a = np.concatenate(rho_l) if rho_l else np.empty(0)
@@ -689,23 +688,46 @@ FAN_RATIO = 0.85  # a fan's triangles keep their ratio (Condition III-ii) below 
 FAN_ANGLES = 165.0  # ... and its spokes' opposite angles below this sum (degrees)
 
 
-def _fan_figures(radii: np.ndarray, phi: float):
+def _fan_figures(radii: np.ndarray, phi):
     """For fans round an apex, spokes ``radii`` (rows, one fan a row; the
-    first spoke 1) ``phi`` apart on the development: the worst Condition
-    III-ii ratio of their triangles and the largest sum of the two angles
-    opposite a spoke (a spoke is a Delaunay edge while it stays below π)."""
+    first spoke 1), spoke k and k + 1 ``phi`` apart on the development (a
+    scalar, or one angle per spoke, rows like ``radii``): the worst
+    Condition III-ii ratio of their triangles, the largest sum of the two
+    angles opposite a spoke (a spoke is a Delaunay edge while it stays below
+    π) and the shortest chord between neighbouring spokes' ends."""
     a, b = radii, np.roll(radii, -1, axis=1)  # spoke k and spoke k + 1
-    c = np.sqrt(a * a + b * b - 2 * a * b * math.cos(phi))
+    c = np.sqrt(a * a + b * b - 2 * a * b * np.cos(phi))
     side = np.sort(np.stack([a, b, c], axis=2), axis=2)
     ratio = (side[..., 1] / side[..., 2]).max(axis=1)
     # in triangle (apex, k, k + 1): the angle at k + 1 faces spoke k, the one at k faces k + 1
     at_next = np.arccos(np.clip((b * b + c * c - a * a) / (2 * b * c), -1, 1))
     at_this = np.arccos(np.clip((a * a + c * c - b * b) / (2 * a * c), -1, 1))
     opposite = at_next + np.roll(at_this, 1, axis=1)  # both triangles on spoke k
-    return ratio, np.degrees(opposite.max(axis=1))
+    return ratio, np.degrees(opposite.max(axis=1)), c.min(axis=1)
 
 
-def _apex_fan(theta: float) -> np.ndarray | None:
+@dataclass(frozen=True)
+class Fan:
+    """Spokes round a cone's apex (:func:`_apex_fan`).
+
+    Attributes
+    ----------
+    radii : (m,) float64
+        Spoke lengths, the first 1 (times the radius of the ring they replace).
+    at : (m,) float64
+        Each spoke's angle about the axis, as a fraction of the full turn
+        (the first 0); on the development, spoke k stands at ``at[k]`` times
+        the development's angle.
+    """
+
+    radii: np.ndarray
+    at: np.ndarray
+
+
+FAN_CHORD = 0.4  # an uneven fan's neighbouring spoke ends keep this far apart (times t)
+
+
+def _apex_fan(theta: float) -> Fan | None:
     """Spokes round a cone's apex that meet Condition III-ii, or None.
 
     The ring nearest a cone's apex (``theta``: the development's angle) with
@@ -720,28 +742,62 @@ def _apex_fan(theta: float) -> np.ndarray | None:
     spokes before 2 (an apex of degree 2 has two triangles on the same three
     samples, which no triangle mesh holds: a reconstruction must cone it), the
     count whose spokes are nearest 90° apart (the lattice's right angles),
-    then the lowest worst ratio.  Returns the spoke lengths, or None when no
-    fan qualifies with that margin (developments below 83° or from 115° to
-    142°, cone_tip's 126° among them).  Deterministic: the first of equal
-    fans in grid order.
+    then the lowest worst ratio.  Where no evenly spaced fan qualifies
+    (developments below 83° or from 115° to 142°), 3 spokes unevenly
+    spaced: gaps on a 2° grid of at least 6°, lengths 0.40 to 1.00 (step
+    0.02), neighbouring ends at least ``FAN_CHORD`` apart, the lowest worst
+    ratio (cone_tip's 126° development: spokes 1, 0.76, 1 with gaps 22°,
+    22° and 82°, ratio 0.76).  Deterministic: the first of equal fans in
+    grid order.
     """
     grid = np.round(np.arange(0.40, 1.0001, 0.01), 2)
     best = None
     for m in (2, 3, 4):
         rest = np.stack(np.meshgrid(*[grid] * (m - 1), indexing="ij"), -1).reshape(-1, m - 1)
         radii = np.c_[np.ones(rest.shape[0]), rest]
-        ratio, angles = _fan_figures(radii, theta / m)
+        ratio, angles, _ = _fan_figures(radii, theta / m)
         ok = np.flatnonzero((ratio < FAN_RATIO) & (angles < FAN_ANGLES))
         if ok.size:
             i = ok[np.argmin(ratio[ok])]
             key = (m == 2, round(abs(math.degrees(theta / m) - 90.0), 9), ratio[i])
             if best is None or key < best[0]:
                 best = (key, radii[i])
-    return None if best is None else best[1]
+    if best is not None:
+        m = best[1].size
+        return Fan(radii=best[1], at=np.arange(m) / m)
+    return _uneven_fan(theta)
+
+
+def _uneven_fan(theta: float) -> Fan | None:
+    """3 unevenly spaced spokes for :func:`_apex_fan` (see there), or None."""
+    step = math.radians(2.0)
+    gaps = np.arange(3, int(theta / step) + 1) * step  # from 6 degrees
+    g1, g2 = (x.ravel() for x in np.meshgrid(gaps, gaps, indexing="ij"))
+    ok = theta - g1 - g2 >= 3 * step - 1e-9
+    g1, g2 = g1[ok], g2[ok]
+    grid = np.round(np.arange(0.40, 1.0001, 0.02), 2)
+    r2, r3 = (x.ravel() for x in np.meshgrid(grid, grid, indexing="ij"))
+    # every gap pair with every pair of lengths (gaps outer, lengths inner)
+    phi = np.stack([g1, g2, theta - g1 - g2], axis=1).repeat(r2.size, axis=0)
+    radii = np.tile(np.stack([np.ones(r2.size), r2, r3], axis=1), (g1.size, 1))
+    ratio, angles, chord = _fan_figures(radii, phi)
+    ok = np.flatnonzero((ratio < FAN_RATIO) & (angles < FAN_ANGLES) & (chord >= FAN_CHORD))
+    if ok.size == 0:
+        return None
+    i = ok[np.argmin(ratio[ok])]
+    return Fan(radii=radii[i], at=np.r_[0.0, np.cumsum(phi[i, :2])] / theta)
 
 
 def _repair_developed(
-    rho, ang, row, rim_ang, slant: float, sin_a: float, t: float, apex_keep: float = APEX_KEEP
+    rho,
+    ang,
+    row,
+    rim_ang,
+    slant: float,
+    sin_a: float,
+    t: float,
+    apex_keep: float = APEX_KEEP,
+    broken_at: float = SQRT3_2,
 ):
     """Repair a cone's rings where they break Condition III-ii, on the cone's development.
 
@@ -788,7 +844,7 @@ def _repair_developed(
     tri = Delaunay(pts).simplices
     tri = tri[inside(pts[tri].mean(axis=1))]
     side = np.sort(np.linalg.norm(pts[tri] - pts[np.roll(tri, 1, axis=1)], axis=2), axis=1)
-    broken = pts[tri[side[:, 1] >= SQRT3_2 * side[:, 2]]].mean(axis=1)
+    broken = pts[tri[side[:, 1] >= broken_at * side[:, 2]]].mean(axis=1)
     near = np.zeros(n, dtype=bool)
     if broken.shape[0]:
         tree = cKDTree(broken)
@@ -870,10 +926,13 @@ def _halving_count(x: float) -> int:
 
 
 POLE_REACH = 10  # rings nearer a smooth pole than this (times t) are repaired
+APEX_SETTLED = 4.0  # round a cone tip's apex, a second repair keeps this near (times t) ...
+APEX_BROKEN = 0.85  # ... and mends the triangles from this ratio
 
 
 def _repair_pole(ring, columns, faces, t: float, end: int):
-    """Repair the rings round a smooth pole (a sphere's) of a body of revolution.
+    """Repair the rings round a pole of a body of revolution: a sphere's
+    smooth pole or a cone's apex.
 
     Near the pole the rings halve like a disk's (every other column ends),
     and where they halve Delaunay triangles break Condition III-ii (the
@@ -883,37 +942,67 @@ def _repair_pole(ring, columns, faces, t: float, end: int):
     of a pole of a sphere of radius R, circles shrink by at most
     ``sin(x) / x`` at ``x = POLE_REACH t / R``) and repaired there as a
     developed cone without a cut (:func:`_repair_developed`), the pole and
-    the ring at ``POLE_REACH`` t fixed.  ``end`` 0 is the pole before the
-    first ring, 1 the one after the last.  Returns the rings replaced, per
-    new sample its (distance from the pole, angle) and ring (-1 for an
-    added sample), and a report; or ``([], [], [], None)`` when the face at
-    that end is no sphere (a cone's apex is left as it is: repaired, its
-    samples opened the tip's reconstruction, 9 open edges), or the sphere
-    or the body is too short.
+    the ring at ``POLE_REACH`` t fixed.  A cone's apex is mapped exactly, on
+    the cone's development (its sides glued), and the ring round it first
+    becomes a designed fan (:func:`_apex_fan`), which stays, as on a cone
+    with a rim (:func:`lattice_cone_faces`).  A second repair then keeps
+    the apex's neighbourhood (``APEX_SETTLED`` t) and mends the triangles
+    from ``APEX_BROKEN`` on: where the rings halve, the development's
+    0.865 came out at 0.866 on the truth mesh (whose 63 facets round the
+    axis make the cone's angle 0.1° short); one repair with that margin
+    throughout moved the apex's samples too, and the tip's reconstruction
+    then closed a triangle across the cone 1.5 t from the apex (two
+    components).  ``end`` 0 is the pole before
+    the first ring, 1 the one after the last.  Returns the rings replaced,
+    per new sample its (distance from the pole, angle) and ring (-1 for an
+    added sample), and a report (for an apex with the second repair's
+    ``margin_bad`` and ``margin_worst``); or ``([], [], [], None)`` when the face at
+    that end is neither a sphere nor a cone with a fan for its angle (its
+    apex stays as laid out), or the face or the body is too short.
     """
     n = len(ring)
     order = list(range(n)) if end == 0 else list(range(n - 1, -1, -1))
-    if n <= POLE_REACH + 1 or faces[ring[order[0]][0]].geomType() != "SPHERE":
+    face = faces[ring[order[0]][0]]
+    kind = face.geomType()
+    if n <= POLE_REACH + 1:
         return [], [], [], None
     inner = order[: POLE_REACH - 1]  # rings 1 .. POLE_REACH - 1 steps from the pole
     rim = order[POLE_REACH - 1]
-    if any(ring[j][0] != ring[rim][0] for j in inner):
-        return [], [], [], None  # the sphere ends before the rim: the map would cross faces
-    rho = np.concatenate([np.full(columns[j].size, (k + 1) * t) for k, j in enumerate(inner)])
-    ang = np.concatenate([columns[j] for j in inner])
-    row = np.concatenate([np.full(columns[j].size, j) for j in inner])
+    if kind not in ("SPHERE", "CONE") or any(ring[j][0] != ring[rim][0] for j in inner):
+        return [], [], [], None  # the face ends before the rim: the map would cross faces
+    rho = [np.full(columns[j].size, (k + 1) * t) for k, j in enumerate(inner)]
+    ang = [columns[j] for j in inner]
+    row = [np.full(columns[j].size, j) for j in inner]
+    sin_a, keep = 1.0, 0.5
+    if kind == "CONE":
+        sin_a = math.sin(abs(face._geomAdaptor().Cone().SemiAngle()))
+        fan = _apex_fan(2 * math.pi * sin_a)
+        if fan is None:
+            return [], [], [], None
+        rho[0] = t * fan.radii
+        ang[0] = (ang[0][0] + 2 * math.pi * fan.at) % (2 * math.pi)
+        row[0] = np.full(fan.radii.size, inner[0])
+        keep = FAN_KEEP
+    rho_a, ang_a, row_a = np.concatenate(rho), np.concatenate(ang), np.concatenate(row)
     r2, a2, row2, bad, worst = _repair_developed(
-        rho, ang, row, columns[rim], POLE_REACH * t, 1.0, t, apex_keep=0.5
+        rho_a, ang_a, row_a, columns[rim], POLE_REACH * t, sin_a, t, apex_keep=keep
     )
+    margin = None
+    if kind == "CONE":  # then the halvings farther out, with a margin
+        r2, a2, row2, *margin = _repair_developed(
+            r2, a2, row2, columns[rim], POLE_REACH * t, sin_a, t, APEX_SETTLED, APEX_BROKEN
+        )
     report = {
-        "kind": "pole",
+        "kind": "pole" if kind == "SPHERE" else "apex",
         "face": int(ring[order[0]][0]),
-        "samples": int(rho.size),
+        "samples": int(rho_a.size),
         "added": int((row2 < 0).sum()),
-        "removed": int(rho.size - (row2 >= 0).sum()),
+        "removed": int(rho_a.size - (row2 >= 0).sum()),
         "bad": int(bad),
         "worst": float(worst),
     }
+    if margin is not None:
+        report.update(margin_bad=int(margin[0]), margin_worst=float(margin[1]))
     return inner, list(zip(r2.tolist(), a2.tolist())), row2.tolist(), report
 
 
