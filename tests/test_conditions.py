@@ -203,3 +203,37 @@ def test_chords_stand_for_geodesics_only_where_the_patch_is_flat_between():
     mid = 1 + 3 * m  # ring 4: a point, the one facing away from it, and its neighbour
     assert not _chord_ok(patches, np.array([mid]), np.array([mid + m // 2]))[0]
     assert _chord_ok(patches, np.array([mid]), np.array([mid + 1]))[0]
+
+
+@pytest.mark.parametrize(
+    "height, crossings, flipped",
+    [
+        (0.3, 50, True),  # opposite angles 2 x 118 degrees: plainly not Delaunay
+        (0.4913, 50, False),  # 2 x 91 degrees: within FLIP_MARGIN of pi, the labels stand
+        (0.4913, 3, True),  # ... unless the edge is a near tie
+        (0.6, 50, False),  # 2 x 80 degrees: Delaunay
+    ],
+)
+def test_edges_plainly_not_delaunay_are_flipped(height, crossings, flipped):
+    """The labels' DT_M edge (a, b) with triangles (a, b, c) and (a, b, d),
+    c and d at ``height`` on either side of its middle: the angle test
+    flips it to (c, d) when the angles at c and d exceed π by more than
+    FLIP_MARGIN (a labelling error where samples crowd, as round a cone's
+    designed fan), or by anything on a near tie; a Delaunay edge stays."""
+    from validators.conditions import FLIP_MARGIN, _flip_near_ties
+
+    assert FLIP_MARGIN == 5.0
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, height], [0.5, -height]])
+    edges = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3]])
+    cross = np.array([crossings, 40, 40, 40, 40])
+    tri = np.array([[0, 1, 2], [0, 1, 3]])
+
+    def geodesics(pairs):
+        return np.linalg.norm(pts[pairs[:, 0]] - pts[pairs[:, 1]], axis=1)
+
+    e, _, t = _flip_near_ties(pts, (edges, cross, tri), geodesics)
+    got = {tuple(x) for x in e.tolist()}
+    assert ((2, 3) in got, (0, 1) in got) == (flipped, not flipped)
+    assert len(got) == 5
+    want = [[0, 2, 3], [1, 2, 3]] if flipped else [[0, 1, 2], [0, 1, 3]]
+    assert sorted(t.tolist()) == want

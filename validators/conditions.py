@@ -16,6 +16,7 @@ projection flattens a fold, so the figures there are an approximation.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -435,6 +436,7 @@ def _settle(pts, tv, tf, snap, orphans, dt, resolution, sharp_degrees):
 # lie within about the resolution of one circle, so the labels may have taken
 # the wrong diagonal
 TIE_CROSSINGS = 6
+FLIP_MARGIN = 5.0  # degrees: any other DT_M edge this far from Delaunay is the labels' error
 
 
 def _quads(tri: np.ndarray, edges: np.ndarray, n: int) -> np.ndarray:
@@ -458,22 +460,31 @@ def _angle(x, y, z) -> np.ndarray:
     return np.arccos(np.clip((x * x + y * y - z * z) / (2.0 * x * y), -1.0, 1.0))
 
 
-def _flip_near_ties(pts, dt, geodesics: _Geodesics, rounds: int = 4):
-    """Decide the near ties of DT_M by the intrinsic Delaunay criterion.
+def _flip_near_ties(pts, dt, geodesics: _Geodesics, rounds: int = 8):
+    """Decide the near ties of DT_M, and mend the labels' plain errors, by
+    the intrinsic Delaunay criterion.
 
-    For each near-tie edge (a, b) (:data:`TIE_CROSSINGS`) with triangles
-    (a, b, c) and (a, b, d), the angles at c and d come from the geodesic
-    lengths of the five pairs (each triangle developed flat); when they sum
-    to more than π the edge is not locally Delaunay and is flipped to (c, d)
-    (Lawson's flip; a triangle takes part in one flip a round).  On a flat
-    face, and across a straight sharp edge (which develops flat), this is
-    exact whatever the resolution of the labels.  A sum within 1e-9 of π
-    (truly cocircular samples) keeps the labelled diagonal.
+    For each edge (a, b) with triangles (a, b, c) and (a, b, d), the angles
+    at c and d come from the geodesic lengths of the five pairs (each
+    triangle developed flat); when they sum to more than π the edge is not
+    locally Delaunay and is flipped to (c, d) (Lawson's flip; a triangle
+    takes part in one flip a round; never onto a pair that is already an
+    edge).  A near tie (:data:`TIE_CROSSINGS`) is flipped at any excess
+    over π (a sum within 1e-9 of π, truly cocircular samples, keeps the
+    labelled diagonal); any other edge only at an excess over
+    ``FLIP_MARGIN``: there the labels took a diagonal that is plainly not
+    Delaunay (Dijkstra's distances along the mesh edges run a few percent
+    long, which moves the cells' borders where samples crowd, as round a
+    designed fan at a cone's apex), while the developed angles of a curved
+    face's small triangles err by far less (a triangle of side h on a
+    sphere of radius R: about ``h^2 / 2R^2`` radians).  On a flat face, and
+    across a straight sharp edge (which develops flat), the test is exact
+    whatever the resolution of the labels.
     """
     n = pts.shape[0]
     edges, cross, tri = dt
     for _ in range(rounds):
-        q = _quads(tri, edges[cross <= TIE_CROSSINGS], n) if tri.size else np.empty((0, 4))
+        q = _quads(tri, edges, n) if tri.size else np.empty((0, 4), dtype=np.int64)
         if q.size == 0:
             break
         pairs = np.sort(
@@ -481,7 +492,12 @@ def _flip_near_ties(pts, dt, geodesics: _Geodesics, rounds: int = 4):
             axis=1,
         )
         ab, ac, bc, ad, bd = geodesics(pairs).reshape(5, -1)
-        flips = q[_angle(ac, bc, ab) + _angle(ad, bd, ab) > np.pi + 1e-9]
+        code = edges[:, 0] * n + edges[:, 1]
+        tie = cross[np.searchsorted(code, q[:, 0] * n + q[:, 1])] <= TIE_CROSSINGS
+        excess = _angle(ac, bc, ab) + _angle(ad, bd, ab) - np.pi
+        cd = np.minimum(q[:, 2], q[:, 3]) * n + np.maximum(q[:, 2], q[:, 3])
+        bar = np.where(tie, 1e-9, math.radians(FLIP_MARGIN))
+        flips = q[(excess > bar) & ~np.isin(cd, code)]
         if flips.size == 0:
             break
         old = [np.sort(flips[:, [0, 1, 2]], axis=1), np.sort(flips[:, [0, 1, 3]], axis=1)]
@@ -532,7 +548,9 @@ def sample_conditions(
     triangle (a cell whose corners fell between the truth's vertices) is
     labelled again finer round it (:func:`_settle`), and a near tie (four
     samples nearly on one circle) takes the diagonal of the intrinsic
-    Delaunay angle test (:func:`_flip_near_ties`).  Geodesic lengths of
+    Delaunay angle test (:func:`_flip_near_ties`), as does any edge whose
+    opposite angles exceed π by more than ``FLIP_MARGIN`` (where samples
+    crowd, Dijkstra's labels can be plainly wrong).  Geodesic lengths of
     DT_M edges are exact mesh geodesics (potpourri3d's edge-flip solver)
     between the samples.  Before that the truth is refined
     (:func:`validators.refine.refine_to_edge_length`) until no edge is
@@ -552,8 +570,9 @@ def sample_conditions(
         median nearest-neighbour distance.
     flip_ties : bool
         Decide near ties (four samples within about the resolution of one
-        circle) by the intrinsic Delaunay angle test on geodesic lengths
-        (:func:`_flip_near_ties`) instead of by the labels alone.
+        circle), and edges plainly not Delaunay, by the intrinsic Delaunay
+        angle test on geodesic lengths (:func:`_flip_near_ties`) instead of
+        by the labels alone.
 
     Returns
     -------
