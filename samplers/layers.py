@@ -656,9 +656,22 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         row_a = np.concatenate(row_l) if row_l else np.empty(0, np.int64)
         bad = worst = None
         if rho_a.size:
-            rho_a, ang_a, row_a, bad, worst = _repair_developed(
-                rho_a, ang_a, row_a, rim_ang, slant, sin_a, t, keep
-            )
+            got = _repair_developed(rho_a, ang_a, row_a, rim_ang, slant, sin_a, t, keep)
+            if got[4] >= SQRT3_2:  # stuck: once more from the layout, wider and longer
+                wide = _repair_developed(
+                    rho_a,
+                    ang_a,
+                    row_a,
+                    rim_ang,
+                    slant,
+                    sin_a,
+                    t,
+                    keep,
+                    movable=WIDE_MOVABLE,
+                    max_edits=WIDE_EDITS,
+                )
+                got = wide if wide[4] < got[4] else got
+            rho_a, ang_a, row_a, bad, worst = got
         z = rho_a * math.cos(abs(cone.SemiAngle()))
         rr = rho_a * sin_a
         new = (
@@ -683,6 +696,8 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
 
 
 APEX_KEEP = 5.0  # samples this near the apex (times t) stay
+WIDE_MOVABLE = 8.0  # a cone's repair left a ratio above sqrt(3)/2: again, this far (times t)
+WIDE_EDITS = 200  # ... with this many removals or insertions
 FAN_KEEP = 1.3  # ... or, round a designed fan, this near (times the fan's radius)
 FAN_RATIO = 0.85  # a fan's triangles keep their ratio (Condition III-ii) below this
 FAN_ANGLES = 165.0  # ... and its spokes' opposite angles below this sum (degrees)
@@ -798,6 +813,8 @@ def _repair_developed(
     t: float,
     apex_keep: float = APEX_KEEP,
     broken_at: float = SQRT3_2,
+    movable: float = MOVABLE,
+    max_edits: int | None = None,
 ):
     """Repair a cone's rings where they break Condition III-ii, on the cone's development.
 
@@ -848,7 +865,7 @@ def _repair_developed(
     near = np.zeros(n, dtype=bool)
     if broken.shape[0]:
         tree = cKDTree(broken)
-        near = np.any([tree.query(q)[0] <= MOVABLE * t for q in copies(uv, turn)], axis=0)
+        near = np.any([tree.query(q)[0] <= movable * t for q in copies(uv, turn)], axis=0)
     free = near & (rho > apex_keep * t)
     if not free.any():
         return rho, ang, row, 0, 0.0
@@ -861,6 +878,7 @@ def _repair_developed(
         inside=inside,
         clamp=_radial_clamp(0.0, slant - 0.25 * t),
         turn=turn,
+        max_edits=max_edits,
     )
     mine = out.origin < n  # not the rim nor the apex
     uv2 = out.uv[mine]
