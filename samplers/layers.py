@@ -39,6 +39,7 @@ END_MERGED = 1.65  # ... unless the merged gap would exceed this
 NARROW = 0.6  # ... or it ends anyway once a gap is below this (times the row step)
 ARC_MARGIN = 0.5  # free samples keep this far (times h) from a cylinder's rim (else h / 4)
 LINE_EDITS = 40  # edits on a face with slanted straight edges only
+RETRY_WIDE = 1.2  # a stuck face's repair runs again with circumradii up to this (times h)
 
 
 @dataclass
@@ -459,10 +460,7 @@ def repair_planar_faces(
             clamps = ([_clamp(arcs, sides, h)] if arcs else []) + (
                 [_clamp_lines(lines, h)] if lines else []
             )
-            done[key] = repair(
-                uv,
-                free,
-                h,
+            args = dict(
                 slide=slide,
                 project=_project_onto(arcs + lines, 0.3 * h) if arcs or lines else None,
                 inside=raster,
@@ -472,6 +470,11 @@ def repair_planar_faces(
                 judge_frame=True,
                 max_edits=None if arcs else LINE_EDITS,
             )
+            done[key] = repair(uv, free, h, **args)
+            if arcs and done[key].worst >= SQRT3_2:  # stuck: allow wider cells
+                again = repair(uv, free, h, wide=RETRY_WIDE, **args)
+                if again.worst < done[key].worst:
+                    done[key] = again
         r = done[key]
         src = np.where(r.origin >= 0, idx[np.maximum(r.origin, 0)], -1)
         moved = src >= 0

@@ -96,6 +96,7 @@ class _Problem:
         frame=None,
         judge_frame=False,
         turn=None,
+        wide=WIDE,
     ):
         self.uv = np.asarray(uv, dtype=np.float64).copy()
         self.free = np.asarray(free, dtype=bool).copy()
@@ -109,6 +110,7 @@ class _Problem:
         self.frame = np.empty((0, 2)) if frame is None else np.asarray(frame, dtype=np.float64)
         self.frame_id = FRAME if judge_frame else GHOST
         self.turn = turn
+        self.wide = wide
         self._watch: np.ndarray | None = None
 
     def watch(self) -> np.ndarray:
@@ -287,7 +289,7 @@ def _energy(prob: _Problem, subset=None, active=None):
     area = 0.5 * np.abs(cross)
     # (capped: a sliver's radius would overflow the square below)
     radius = np.minimum(length.prod(axis=1) / np.maximum(4.0 * area, 1e-300), 1e6 * h)
-    wide = np.maximum(0.0, radius - WIDE * h) / h
+    wide = np.maximum(0.0, radius - prob.wide * h) / h
     energy += float((wide**2).sum())
     # a simple gradient for the radius term: pull the triangle's corners to its centroid
     cen = p.mean(axis=1)
@@ -383,6 +385,7 @@ def repair(
     frame=None,
     judge_frame: bool = False,
     turn: float | None = None,
+    wide: float = WIDE,
     descent_steps: int = 300,
     max_edits: int | None = None,
 ) -> Repaired:
@@ -430,6 +433,9 @@ def repair(
         ``[0, turn)``; those near a side have moving images across the other
         (their gradients turned back), so that the cone's triangles across
         its cut, and round its apex, are judged and mended like the others.
+    wide : float
+        Circumradii above this (times ``h``) are penalised (a larger bound
+        lets the descent leave wider cells where the default one is stuck).
     descent_steps, max_edits : int
         Work limits (``max_edits`` defaults to an eighth of the movable
         samples, at least 80).
@@ -475,6 +481,7 @@ def repair(
         frame,
         judge_frame,
         turn,
+        wide,
     )
     _descend(prob, descent_steps)
     nbad, _, bad, worst = _status(prob)
