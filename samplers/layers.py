@@ -708,10 +708,10 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
 
 
 APEX_KEEP = 5.0  # samples this near the apex (times t) stay
-WIDE_MOVABLE = 6.0  # a cone's repair left a ratio above sqrt(3)/2: again, this far (times t)
 FAN_KEEP = 1.3  # ... or, round a designed fan, this near (times the fan's radius)
 FAN_RATIO = 0.85  # a fan's triangles keep their ratio (Condition III-ii) below this
 FAN_ANGLES = 165.0  # ... and its spokes' opposite angles below this sum (degrees)
+WIDE_MOVABLE = 6.0  # a cone's repair left a ratio above sqrt(3)/2: again, this far (times t)
 
 
 def _fan_figures(radii: np.ndarray, phi):
@@ -772,9 +772,9 @@ def _apex_fan(theta: float) -> Fan | None:
     (developments below 83° or from 115° to 142°), 3 spokes unevenly
     spaced: gaps on a 2° grid of at least 6°, lengths 0.40 to 1.00 (step
     0.02), neighbouring ends at least ``FAN_CHORD`` apart, the lowest worst
-    ratio (cone_tip's 126° development: spokes 1, 0.76, 1 with gaps 22°,
-    22° and 82°, ratio 0.76).  Deterministic: the first of equal fans in
-    grid order.
+    ratio (cone_tip's 126° development: spokes 1, 1 and 0.76 with gaps of
+    82°, 22° and 22°, ratio 0.76).  None qualifies below 83° nor at 115°
+    and 116°.  Deterministic: the first of equal fans in grid order.
     """
     grid = np.round(np.arange(0.40, 1.0001, 0.01), 2)
     best = None
@@ -849,8 +849,8 @@ def _repair_developed(
     ``apex_keep`` (times t) sets the fixed neighbourhood of the apex; the
     triangles to mend are those whose ratio is ``broken_at`` or more on the
     development, and the samples within ``movable`` (times t) of them may
-    move.  Returns the new (rho, ang, row; -1 for an added sample), the triangles
-    left above the repair's margin and the worst ratio.
+    move.  Returns the new (rho, ang, row; -1 for an added sample), the
+    triangles left above the repair's margin and the worst ratio.
     """
     full = sin_a >= 1.0 - 1e-12
     theta = 2 * math.pi * sin_a
@@ -981,13 +981,13 @@ def _repair_pole(ring, columns, faces, t: float, end: int):
     axis make the cone's angle 0.1° short); one repair with that margin
     throughout moved the apex's samples too, and the tip's reconstruction
     then closed a triangle across the cone 1.5 t from the apex (two
-    components).  ``end`` 0 is the pole before
-    the first ring, 1 the one after the last.  Returns the rings replaced,
-    per new sample its (distance from the pole, angle) and ring (-1 for an
-    added sample), and a report (for an apex with the second repair's
-    ``margin_bad`` and ``margin_worst``); or ``([], [], [], None)`` when the face at
-    that end is neither a sphere nor a cone with a fan for its angle (its
-    apex stays as laid out), or the face or the body is too short.
+    components).  ``end`` 0 is the pole before the first ring, 1 the one
+    after the last.  Returns the rings replaced, per new sample its
+    (distance from the pole, angle) and ring (-1 for an added sample), and
+    a report (for an apex with the second repair's ``margin_bad`` and
+    ``margin_worst``); or ``([], [], [], None)`` when the face at that end
+    is neither a sphere nor a cone with a fan for its angle (its apex stays
+    as laid out), or the face or the body is too short.
     """
     n = len(ring)
     order = list(range(n)) if end == 0 else list(range(n - 1, -1, -1))
