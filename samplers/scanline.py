@@ -50,11 +50,14 @@ CadQuery is imported only when this module's functions run.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from scipy.spatial import cKDTree
+
+from sr33._progress import bar, log, timed
 
 from .adjacency import EdgeFaces
 
@@ -662,6 +665,7 @@ def scan(
     seed: int = 0,
     sharp_degrees: float = 20.0,
     repair: bool = True,
+    quiet: bool = True,
 ) -> ScanSamples:
     """Sample a CAD shape along scan lines (Condition III, Figure 1 of the paper).
 
@@ -691,6 +695,10 @@ def scan(
         Lay disks out in rings and repair the boundary layers where rows
         meet circular edges (:mod:`samplers.disks`, :mod:`samplers.layers`),
         so that Condition III-ii holds there too.
+    quiet : bool
+        No progress bar (one step per face's scan rows, then one per repair
+        stage; shown only when stderr is a terminal).  Every step's time is
+        logged at debug level (logger ``sr33``) either way.
 
     Returns
     -------
@@ -701,6 +709,40 @@ def scan(
     faces = occ.Faces()
     if not faces:
         raise SamplingError("shape has no faces to sample")
+    with bar(len(faces) + 2 + (5 if repair else 0), "sample", quiet, unit="step") as pbar:
+        return _scan(
+            shape,
+            occ,
+            faces,
+            dirs,
+            spacing,
+            target_points,
+            ratio,
+            jitter,
+            dropout,
+            seed,
+            sharp_degrees,
+            repair,
+            pbar,
+        )
+
+
+def _scan(
+    shape,
+    occ,
+    faces,
+    dirs,
+    spacing,
+    target_points,
+    ratio,
+    jitter,
+    dropout,
+    seed,
+    sharp_degrees,
+    repair,
+    pbar,
+) -> ScanSamples:
+    """:func:`scan` after its arguments are checked; ``pbar`` counts its steps."""
     lo, hi = _exact_bounds(occ)
     size = float(np.linalg.norm(hi - lo))
     area = float(sum(f.Area() for f in faces))
@@ -731,13 +773,17 @@ def scan(
         # last plane meets the far side as the first meets the near side
         hf = _dividing_step(float((corner @ d).max()) - t0, h)
         planes.append((d, t0, hf, _columns(face, d, hf, ratio, lo, axis_steps)))
-    pts, fids, feature_curve, lattices = _feature_samples(
-        occ, EDGE_STEP * h, sharp_degrees, tol, planes
-    )
+    with timed("sample: feature samples"):
+        pts, fids, feature_curve, lattices = _feature_samples(
+            occ, EDGE_STEP * h, sharp_degrees, tol, planes
+        )
+    pbar.update(1)
     n_feature = len(pts)
     line_ids = [-1] * n_feature
     line = 0
+    t_rows = time.perf_counter()
     for fi, face in enumerate(faces):
+        pbar.update(1)
         d, t0, hf, _ = planes[fi]
         sphere = _sphere_frame(face, d)
         flo, fhi = _exact_bounds(face)
@@ -772,6 +818,7 @@ def scan(
                 fids.extend([fi] * len(p))
                 line_ids.extend([line] * len(p))
                 line += 1
+    log.debug("sample: scan rows took %.4f s", time.perf_counter() - t_rows)
     allp = np.array(pts, dtype=np.float64).reshape(-1, 3)
     on_line = np.arange(allp.shape[0]) >= n_feature
     alive = np.flatnonzero(_drop_near_features(allp, on_line, feature_curve, FEATURE_CLEARANCE * h))
@@ -780,7 +827,9 @@ def scan(
     line_id = np.array(line_ids, dtype=np.int64)[keep]
     face_id = np.array(fids, dtype=np.int64)[keep]
     on_feature = keep < n_feature
-    fill = _fill_gaps(occ, faces, points, h, size)
+    with timed("sample: gaps filled"):
+        fill = _fill_gaps(occ, faces, points, h, size)
+    pbar.update(1)
     if fill.shape[0]:
         points = np.vstack([points, fill])
         line_id = np.r_[line_id, np.full(fill.shape[0], -2, dtype=np.int64)]
@@ -798,13 +847,22 @@ def scan(
         )
 
         bag = Samples(points, line_id, face_id, on_feature)
-        reports, rings = lattice_disk_faces(occ, bag, h, size)
-        reports += repair_planar_faces(
-            occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=rings
-        )
-        reports += lattice_cylinder_faces(occ, bag, h, size)
-        reports += lattice_cone_faces(occ, bag, h, size)
-        reports += lattice_revolved_body(occ, bag, h, size)
+        with timed("sample: disks"):
+            reports, rings = lattice_disk_faces(occ, bag, h, size)
+        pbar.update(1)
+        with timed("sample: planar faces"):
+            reports += repair_planar_faces(
+                occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=rings
+            )
+        pbar.update(1)
+        for step, lay in (
+            ("cylinders", lattice_cylinder_faces),
+            ("cones", lattice_cone_faces),
+            ("bodies of revolution", lattice_revolved_body),
+        ):
+            with timed(f"sample: {step}"):
+                reports += lay(occ, bag, h, size)
+            pbar.update(1)
         points, line_id, face_id, on_feature = (
             bag.points,
             bag.line_id,

@@ -13,10 +13,10 @@ from tqdm.auto import tqdm
 log = logging.getLogger("sr33")
 
 
-def bar(total: int, desc: str, quiet: bool):
+def bar(total: int, desc: str, quiet: bool, unit: str = "pt"):
     """A tqdm bar that is silent with ``quiet`` or when stderr is not a TTY."""
     disable = quiet or not sys.stderr.isatty()
-    return tqdm(total=total, desc=desc, disable=disable, leave=False, unit="pt")
+    return tqdm(total=total, desc=desc, disable=disable, leave=False, unit=unit)
 
 
 def chunks(n: int, parts: int = 50) -> Iterator[tuple[int, int]]:

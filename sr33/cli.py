@@ -135,6 +135,7 @@ def _cmd_sample(args) -> int:
             dropout=args.dropout,
             seed=args.seed,
             repair=not args.no_repair,
+            quiet=args.quiet,
         )
     except (shapes.ShapeError, scanline.SamplingError) as exc:
         raise InputError(str(exc)) from None
@@ -366,6 +367,7 @@ def build_parser() -> argparse.ArgumentParser:
     sm.add_argument("-o", "--output", help="points: .ply .xyz .txt .npy .obj .vtp")
     sm.add_argument("--truth", help="also write the ground-truth mesh here")
     sm.add_argument("--meta", help="also write the metadata as JSON here")
+    sm.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     sm.set_defaults(func=_cmd_sample)
     va = sub.add_parser("validate", help="topology, defects and fidelity of a mesh")
     va.add_argument("mesh")

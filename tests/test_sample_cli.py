@@ -48,10 +48,28 @@ def test_sample_writes_points_truth_and_meta(tmp_path, capsys):
     assert (s.open_edges, s.overloaded_edges, s.euler) == (0, 0, 2)
     m = json.loads(meta.read_text())
     assert m["spacing"] == pytest.approx(0.1) and m["seed"] == 2 and m["points"] == p.shape[0]
-    # same arguments, same file
+    # same arguments, same file (quiet or not)
     again = tmp_path / "p2.ply"
-    assert main(["sample", "cube", "--spacing", "0.1", "--seed", "2", "-o", str(again)]) == 0
+    argv = ["sample", "cube", "--spacing", "0.1", "--seed", "2", "-o", str(again), "--quiet"]
+    assert main(argv) == 0
     assert again.read_bytes() == pts.read_bytes()
+
+
+def test_sampling_logs_every_step_at_debug_level(caplog):
+    """Each step of a sampling logs its time (logger sr33, debug level), in order."""
+    import logging
+    import re
+
+    from samplers import shapes
+    from samplers.scanline import scan
+
+    with caplog.at_level(logging.DEBUG, logger="sr33"):
+        scan(shapes.build("cube"), 0.1)
+        scan(shapes.build("cube"), 0.1, repair=False)
+    steps = re.findall(r"sample: ([a-z ]+) took \d+\.\d+ s", caplog.text)
+    first = ["feature samples", "scan rows", "gaps filled"]
+    repairs = ["disks", "planar faces", "cylinders", "cones", "bodies of revolution"]
+    assert steps == first + repairs + first
 
 
 @pytest.mark.parametrize(
