@@ -242,7 +242,7 @@ def _cmd_conditions(args) -> int:
     if tf.shape[0] == 0:
         raise InputError(f"{args.truth}: has no faces; the truth must be a triangle mesh")
     try:
-        rep = sample_conditions(pts, tv, tf)
+        rep = sample_conditions(pts, tv, tf, quiet=args.quiet)
     except ValueError as exc:
         raise InputError(str(exc)) from None
     width = max(len(r[0]) for r in rep.table())
@@ -378,6 +378,7 @@ def build_parser() -> argparse.ArgumentParser:
     co = sub.add_parser("conditions", help="measure the paper's sample conditions")
     co.add_argument("points")
     co.add_argument("--truth", required=True, help="ground-truth mesh, much finer than h")
+    co.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     co.set_defaults(func=_cmd_conditions)
     vw = sub.add_parser("view", help="inspect a reconstruction (PyVista window or screenshot)")
     vw.add_argument("input", help="points (reconstructed first), a mesh, or a saved .npz")

@@ -97,6 +97,20 @@ def test_conditions_command(plane, tmp_path, capsys):
     out = capsys.readouterr().out
     assert "III-i  DT_M degree <= 33" in out and "pass" in out
     assert "II-ii  geodesic distortion epsilon" in out
+    argv = ["conditions", str(tmp_path / "p.xyz"), "--truth", str(tmp_path / "t.ply"), "-q"]
+    assert main(argv) == 0
+    assert capsys.readouterr().out == out  # the same report, quietly
+
+
+def test_the_check_logs_every_step_at_debug_level(plane, caplog):
+    import logging
+    import re
+
+    p, _ = lattice(0.002)
+    with caplog.at_level(logging.DEBUG, logger="sr33"):
+        sample_conditions(p, *plane)
+    steps = re.findall(r"conditions: ([a-z ]+) took \d+\.\d+ s", caplog.text)
+    assert steps == ["truth refined", "labels", "geodesics", "angle test"]
 
 
 def test_dt_m_of_a_flat_annulus_with_a_cad_truth_is_its_delaunay():

@@ -205,8 +205,9 @@ class _Geodesics:
     once, on first need) between the truth vertices that are the samples.
     """
 
-    def __init__(self, pts, tv, tf, vertex_of):
+    def __init__(self, pts, tv, tf, vertex_of, quiet: bool = True):
         self.pts, self.tv, self.tf, self.vertex_of = pts, tv, tf, vertex_of
+        self.quiet = quiet
         self._solver = None
         self._known: dict[int, float] = {}
 
@@ -223,6 +224,8 @@ class _Geodesics:
     def _compute(self, edges: np.ndarray) -> np.ndarray:
         import potpourri3d as pp3d
 
+        from sr33._progress import bar
+
         from .fidelity import distance_to_surface
 
         a, b = self.pts[edges[:, 0]], self.pts[edges[:, 1]]
@@ -234,11 +237,15 @@ class _Geodesics:
         curved = np.flatnonzero(off > 1e-9 * np.maximum(chord, 1e-300) + 1e-12)
         if curved.size and self._solver is None:
             self._solver = pp3d.EdgeFlipGeodesicSolver(self.tv, self.tf)
-        for i in curved.tolist():
-            path = self._solver.find_geodesic_path(
-                int(self.vertex_of[edges[i, 0]]), int(self.vertex_of[edges[i, 1]])
-            )
-            length[i] = max(float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum()), chord[i])
+        with bar(curved.size, "geodesics", self.quiet, unit="pair") as pbar:
+            for i in curved.tolist():
+                path = self._solver.find_geodesic_path(
+                    int(self.vertex_of[edges[i, 0]]), int(self.vertex_of[edges[i, 1]])
+                )
+                length[i] = max(
+                    float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum()), chord[i]
+                )
+                pbar.update(1)
         return length
 
 
@@ -534,6 +541,7 @@ def sample_conditions(
     sharp_degrees: float = 30.0,
     resolution: float | None = None,
     flip_ties: bool = True,
+    quiet: bool = True,
 ):
     """Measure Conditions II-ii, III-i and III-ii with geodesics on the truth.
 
@@ -573,11 +581,17 @@ def sample_conditions(
         circle), and edges plainly not Delaunay, by the intrinsic Delaunay
         angle test on geodesic lengths (:func:`_flip_near_ties`) instead of
         by the labels alone.
+    quiet : bool
+        No progress bar over the traced geodesics (shown only when stderr is
+        a terminal); every step's time is logged at debug level (logger
+        ``sr33``) either way.
 
     Returns
     -------
     ConditionReport
     """
+
+    from sr33._progress import timed
 
     from .fidelity import sharp_edges
     from .refine import insert_points, refine_to_edge_length
@@ -591,18 +605,24 @@ def sample_conditions(
     ov = np.asarray(truth_vertices, dtype=np.float64)
     of = np.asarray(truth_triangles, dtype=np.int64)
     genus = tuple(c.genus for c in signature(of, ov.shape[0]).components)
-    tv, tf = refine_to_edge_length(ov, of, resolution)
-    tv, tf, snap = insert_points(tv, tf, pts)
-    dt_edges, crossings, dt_tri = _labelled_delaunay(tv, tf, snap, pts, sharp_degrees)
-    orphans = np.setdiff1d(np.arange(n), dt_tri)
-    if orphans.size and dt_tri.size:
-        dt_edges, crossings, dt_tri = _settle(
-            pts, tv, tf, snap, orphans, (dt_edges, crossings, dt_tri), resolution, sharp_degrees
-        )
-    geodesics = _Geodesics(pts, tv, tf, snap)
-    if flip_ties:
+    with timed("conditions: truth refined"):
+        tv, tf = refine_to_edge_length(ov, of, resolution)
+        tv, tf, snap = insert_points(tv, tf, pts)
+    with timed("conditions: labels"):
+        dt_edges, crossings, dt_tri = _labelled_delaunay(tv, tf, snap, pts, sharp_degrees)
+        orphans = np.setdiff1d(np.arange(n), dt_tri)
+        if orphans.size and dt_tri.size:
+            dt_edges, crossings, dt_tri = _settle(
+                pts, tv, tf, snap, orphans, (dt_edges, crossings, dt_tri), resolution, sharp_degrees
+            )
+    geodesics = _Geodesics(pts, tv, tf, snap, quiet)
+    with timed("conditions: geodesics"):
         geodesics(dt_edges)  # every DT_M edge's length, in one pass
-        dt_edges, crossings, dt_tri = _flip_near_ties(pts, (dt_edges, crossings, dt_tri), geodesics)
+    if flip_ties:
+        with timed("conditions: angle test"):
+            dt_edges, crossings, dt_tri = _flip_near_ties(
+                pts, (dt_edges, crossings, dt_tri), geodesics
+            )
     length = geodesics(dt_edges)
     key = dt_edges[:, 0] * n + dt_edges[:, 1]
     order = np.argsort(key)
