@@ -24,6 +24,23 @@ def sampled():
     return out
 
 
+@pytest.fixture(scope="module")
+def checked(sampled):
+    """The geodesic sample-condition check of a shape's default samples, run once."""
+    pytest.importorskip("potpourri3d")
+    from validators.conditions import sample_conditions
+
+    done = {}
+
+    def check(name):
+        if name not in done:
+            s, r = sampled[name]
+            done[name] = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+        return done[name]
+
+    return check
+
+
 def cad_distance(solid, points):
     import cadquery as cq
     from OCP.BRepExtrema import BRepExtrema_DistShapeShape
@@ -401,7 +418,7 @@ def test_round_faces_are_rings_without_bad_triangles(sampled, name):
 
 
 @pytest.mark.parametrize("name", ["square_ring", "cone", "block_two_holes", "cone_tip", "conebox"])
-def test_shapes_meet_condition_iii(sampled, name):
+def test_shapes_meet_condition_iii(checked, name):
     """No sample breaks Condition III by the geodesic check: every sample in
     a DT_M triangle (none left out, as a cone's apex was when its cell's
     corners fell between the truth's vertices) and every ratio below √3/2.
@@ -413,16 +430,12 @@ def test_shapes_meet_condition_iii(sampled, name):
     repair run again over a wider band, its top's stuck boundary layer
     again with wider cells allowed (worst 0.865; 0.29% of the samples
     violating without either)."""
-    pytest.importorskip("potpourri3d")
-    from validators.conditions import sample_conditions
-
-    s, r = sampled[name]
-    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    rep = checked(name)
     assert rep.max_degree <= 33
     assert np.all(rep.worst_ratio < np.sqrt(3) / 2)
 
 
-def test_rings_round_a_pole_and_an_apex_are_repaired(sampled):
+def test_rings_round_a_pole_and_an_apex_are_repaired(sampled, checked):
     """The rings round the cone tip's ball's pole halve like a disk's, and
     where they halved 54 intrinsic Delaunay triangles broke Condition III-ii
     (2.32% of the samples); repaired on the pole's azimuthal map, none is
@@ -434,9 +447,7 @@ def test_rings_round_a_pole_and_an_apex_are_repaired(sampled):
     (nor any other: see test_shapes_meet_condition_iii)."""
     import math
 
-    pytest.importorskip("potpourri3d")
     from samplers.layers import POLE_REACH
-    from validators.conditions import sample_conditions
 
     s, r = sampled["cone_tip"]
     reps = {x["kind"]: x for x in r.meta["repairs"] if x["kind"] in ("pole", "apex")}
@@ -452,7 +463,7 @@ def test_rings_round_a_pole_and_an_apex_are_repaired(sampled):
     np.testing.assert_allclose(spokes[0] / spokes[2], 0.76, atol=1e-9)
     np.testing.assert_allclose(spokes[1], spokes[2], rtol=1e-9)
     assert 0.9 * h < spokes[2] < 1.1 * h
-    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    rep = checked("cone_tip")
     bad = ~(rep.worst_ratio < np.sqrt(3) / 2)
     for end in (np.argmin, np.argmax):
         pole = r.points[on_axis][end(r.points[on_axis, 2])]
