@@ -710,196 +710,165 @@ def scan(
     if not faces:
         raise SamplingError("shape has no faces to sample")
     with bar(len(faces) + 2 + (5 if repair else 0), "sample", quiet, unit="step") as pbar:
-        return _scan(
-            shape,
-            occ,
-            faces,
-            dirs,
-            spacing,
-            target_points,
-            ratio,
-            jitter,
-            dropout,
-            seed,
-            sharp_degrees,
-            repair,
-            pbar,
+        lo, hi = _exact_bounds(occ)
+        size = float(np.linalg.norm(hi - lo))
+        area = float(sum(f.Area() for f in faces))
+        if spacing is not None:
+            h = float(spacing)
+        elif target_points is not None:
+            h = math.sqrt(area / (ratio * target_points))
+        else:
+            h = float(getattr(shape, "default_spacing", 0.0) or math.sqrt(area / (ratio * 6000)))
+        if area / (h * h * ratio) > 2_000_000:
+            raise SamplingError(
+                f"spacing {h:g} would give about {area / (h * h * ratio):.0f} samples; "
+                "the limit is 2,000,000"
+            )
+        tol = 1e-7 * size
+        fam = [_face_family(f, dirs, size / 200) for f in faces]
+        corner = np.array(
+            [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
         )
 
-
-def _scan(
-    shape,
-    occ,
-    faces,
-    dirs,
-    spacing,
-    target_points,
-    ratio,
-    jitter,
-    dropout,
-    seed,
-    sharp_degrees,
-    repair,
-    pbar,
-) -> ScanSamples:
-    """:func:`scan` after its arguments are checked; ``pbar`` counts its steps."""
-    lo, hi = _exact_bounds(occ)
-    size = float(np.linalg.norm(hi - lo))
-    area = float(sum(f.Area() for f in faces))
-    if spacing is not None:
-        h = float(spacing)
-    elif target_points is not None:
-        h = math.sqrt(area / (ratio * target_points))
-    else:
-        h = float(getattr(shape, "default_spacing", 0.0) or math.sqrt(area / (ratio * 6000)))
-    if area / (h * h * ratio) > 2_000_000:
-        raise SamplingError(
-            f"spacing {h:g} would give about {area / (h * h * ratio):.0f} samples; "
-            "the limit is 2,000,000"
-        )
-    tol = 1e-7 * size
-    fam = [_face_family(f, dirs, size / 200) for f in faces]
-    corner = np.array(
-        [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
-    )
-
-    # rows along a coordinate axis: r times that axis's plane spacing
-    axis_steps = ratio * np.array([_dividing_step(float(e), h) for e in hi - lo])
-    planes = []  # per face: its family's direction, first plane, spacing, columns
-    for fi, face in enumerate(faces):
-        d = dirs[fam[fi]]
-        t0 = float((corner @ d).min())
-        # the family's spacing divides the shape's extent along d, so the
-        # last plane meets the far side as the first meets the near side
-        hf = _dividing_step(float((corner @ d).max()) - t0, h)
-        planes.append((d, t0, hf, _columns(face, d, hf, ratio, lo, axis_steps)))
-    with timed("sample: feature samples"):
-        pts, fids, feature_curve, lattices = _feature_samples(
-            occ, EDGE_STEP * h, sharp_degrees, tol, planes
-        )
-    pbar.update(1)
-    n_feature = len(pts)
-    line_ids = [-1] * n_feature
-    line = 0
-    t_rows = time.perf_counter()
-    for fi, face in enumerate(faces):
-        pbar.update(1)
-        d, t0, hf, _ = planes[fi]
-        sphere = _sphere_frame(face, d)
-        flo, fhi = _exact_bounds(face)
-        fc = np.array(
-            [
-                [x, y, z]
-                for x in (flo[0], fhi[0])
-                for y in (flo[1], fhi[1])
-                for z in (flo[2], fhi[2])
-            ]
-        )
-        proj = fc @ d
-        j0 = math.ceil((proj.min() - t0) / hf - 1e-9)
-        j1 = math.floor((proj.max() - t0) / hf + 1e-9)
-        for j in range(j0, j1 + 1):
-            t = t0 + j * hf
-            origin = d * t
-            edges = _section(face, tuple(origin), tuple(d))
-            for chain, closed in _chains(edges, max(tol, 1e-9)):
-                p = _sample_chain(
-                    chain,
-                    closed,
-                    ratio * hf,
-                    lo,
-                    axis_steps,
-                    lattices.get(fi, ()),
-                    ratio,
-                    sphere,
-                    FEATURE_CLEARANCE * h,
-                )
-                pts.extend(p)
-                fids.extend([fi] * len(p))
-                line_ids.extend([line] * len(p))
-                line += 1
-    log.debug("sample: scan rows took %.4f s", time.perf_counter() - t_rows)
-    allp = np.array(pts, dtype=np.float64).reshape(-1, 3)
-    on_line = np.arange(allp.shape[0]) >= n_feature
-    alive = np.flatnonzero(_drop_near_features(allp, on_line, feature_curve, FEATURE_CLEARANCE * h))
-    keep = alive[_thin(allp[alive], 0.5 * min(1.0, ratio) * h)]
-    points = allp[keep]
-    line_id = np.array(line_ids, dtype=np.int64)[keep]
-    face_id = np.array(fids, dtype=np.int64)[keep]
-    on_feature = keep < n_feature
-    with timed("sample: gaps filled"):
-        fill = _fill_gaps(occ, faces, points, h, size)
-    pbar.update(1)
-    if fill.shape[0]:
-        points = np.vstack([points, fill])
-        line_id = np.r_[line_id, np.full(fill.shape[0], -2, dtype=np.int64)]
-        face_id = np.r_[face_id, [_nearest_face(q, faces) for q in fill]].astype(np.int64)
-        on_feature = np.r_[on_feature, np.zeros(fill.shape[0], dtype=bool)]
-    reports: list[dict] = []
-    if repair:
-        from .disks import lattice_disk_faces
-        from .layers import (
-            Samples,
-            lattice_cone_faces,
-            lattice_cylinder_faces,
-            lattice_revolved_body,
-            repair_planar_faces,
-        )
-
-        bag = Samples(points, line_id, face_id, on_feature)
-        with timed("sample: disks"):
-            reports, rings = lattice_disk_faces(occ, bag, h, size)
-        pbar.update(1)
-        with timed("sample: planar faces"):
-            reports += repair_planar_faces(
-                occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=rings
+        # rows along a coordinate axis: r times that axis's plane spacing
+        axis_steps = ratio * np.array([_dividing_step(float(e), h) for e in hi - lo])
+        planes = []  # per face: its family's direction, first plane, spacing, columns
+        for fi, face in enumerate(faces):
+            d = dirs[fam[fi]]
+            t0 = float((corner @ d).min())
+            # the family's spacing divides the shape's extent along d, so the
+            # last plane meets the far side as the first meets the near side
+            hf = _dividing_step(float((corner @ d).max()) - t0, h)
+            planes.append((d, t0, hf, _columns(face, d, hf, ratio, lo, axis_steps)))
+        with timed("sample: feature samples"):
+            pts, fids, feature_curve, lattices = _feature_samples(
+                occ, EDGE_STEP * h, sharp_degrees, tol, planes
             )
         pbar.update(1)
-        for step, lay in (
-            ("cylinders", lattice_cylinder_faces),
-            ("cones", lattice_cone_faces),
-            ("bodies of revolution", lattice_revolved_body),
-        ):
-            with timed(f"sample: {step}"):
-                reports += lay(occ, bag, h, size)
+        n_feature = len(pts)
+        line_ids = [-1] * n_feature
+        line = 0
+        t_rows = time.perf_counter()
+        for fi, face in enumerate(faces):
             pbar.update(1)
-        points, line_id, face_id, on_feature = (
-            bag.points,
-            bag.line_id,
-            bag.face_id,
-            bag.on_feature,
+            d, t0, hf, _ = planes[fi]
+            sphere = _sphere_frame(face, d)
+            flo, fhi = _exact_bounds(face)
+            fc = np.array(
+                [
+                    [x, y, z]
+                    for x in (flo[0], fhi[0])
+                    for y in (flo[1], fhi[1])
+                    for z in (flo[2], fhi[2])
+                ]
+            )
+            proj = fc @ d
+            j0 = math.ceil((proj.min() - t0) / hf - 1e-9)
+            j1 = math.floor((proj.max() - t0) / hf + 1e-9)
+            for j in range(j0, j1 + 1):
+                t = t0 + j * hf
+                origin = d * t
+                edges = _section(face, tuple(origin), tuple(d))
+                for chain, closed in _chains(edges, max(tol, 1e-9)):
+                    p = _sample_chain(
+                        chain,
+                        closed,
+                        ratio * hf,
+                        lo,
+                        axis_steps,
+                        lattices.get(fi, ()),
+                        ratio,
+                        sphere,
+                        FEATURE_CLEARANCE * h,
+                    )
+                    pts.extend(p)
+                    fids.extend([fi] * len(p))
+                    line_ids.extend([line] * len(p))
+                    line += 1
+        log.debug("sample: scan rows took %.4f s", time.perf_counter() - t_rows)
+        allp = np.array(pts, dtype=np.float64).reshape(-1, 3)
+        on_line = np.arange(allp.shape[0]) >= n_feature
+        alive = np.flatnonzero(
+            _drop_near_features(allp, on_line, feature_curve, FEATURE_CLEARANCE * h)
         )
-    rng = np.random.default_rng(seed)
-    if jitter > 0:
-        points = points + rng.normal(size=points.shape) * (jitter * h)
-    if dropout > 0:
-        mask = rng.random(points.shape[0]) >= dropout
-        points, line_id, face_id, on_feature = (
-            points[mask],
-            line_id[mask],
-            face_id[mask],
-            on_feature[mask],
+        keep = alive[_thin(allp[alive], 0.5 * min(1.0, ratio) * h)]
+        points = allp[keep]
+        line_id = np.array(line_ids, dtype=np.int64)[keep]
+        face_id = np.array(fids, dtype=np.int64)[keep]
+        on_feature = keep < n_feature
+        with timed("sample: gaps filled"):
+            fill = _fill_gaps(occ, faces, points, h, size)
+        pbar.update(1)
+        if fill.shape[0]:
+            points = np.vstack([points, fill])
+            line_id = np.r_[line_id, np.full(fill.shape[0], -2, dtype=np.int64)]
+            face_id = np.r_[face_id, [_nearest_face(q, faces) for q in fill]].astype(np.int64)
+            on_feature = np.r_[on_feature, np.zeros(fill.shape[0], dtype=bool)]
+        reports: list[dict] = []
+        if repair:
+            from .disks import lattice_disk_faces
+            from .layers import (
+                Samples,
+                lattice_cone_faces,
+                lattice_cylinder_faces,
+                lattice_revolved_body,
+                repair_planar_faces,
+            )
+
+            bag = Samples(points, line_id, face_id, on_feature)
+            with timed("sample: disks"):
+                reports, rings = lattice_disk_faces(occ, bag, h, size)
+            pbar.update(1)
+            with timed("sample: planar faces"):
+                reports += repair_planar_faces(
+                    occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=rings
+                )
+            pbar.update(1)
+            for step, lay in (
+                ("cylinders", lattice_cylinder_faces),
+                ("cones", lattice_cone_faces),
+                ("bodies of revolution", lattice_revolved_body),
+            ):
+                with timed(f"sample: {step}"):
+                    reports += lay(occ, bag, h, size)
+                pbar.update(1)
+            points, line_id, face_id, on_feature = (
+                bag.points,
+                bag.line_id,
+                bag.face_id,
+                bag.on_feature,
+            )
+        rng = np.random.default_rng(seed)
+        if jitter > 0:
+            points = points + rng.normal(size=points.shape) * (jitter * h)
+        if dropout > 0:
+            mask = rng.random(points.shape[0]) >= dropout
+            points, line_id, face_id, on_feature = (
+                points[mask],
+                line_id[mask],
+                face_id[mask],
+                on_feature[mask],
+            )
+        expected = getattr(shape, "expected", None)
+        meta = {
+            "shape": getattr(shape, "name", type(occ).__name__),
+            "params": dict(getattr(shape, "params", {}) or {}),
+            "expected": None if expected is None else vars(expected).copy(),
+            "spacing": h,
+            "ratio": float(ratio),
+            "directions": dirs.tolist(),
+            "face_directions": [int(f) for f in fam],
+            "jitter": float(jitter),
+            "dropout": float(dropout),
+            "seed": int(seed),
+            "sharp_degrees": float(sharp_degrees),
+            "points": int(points.shape[0]),
+            "repairs": reports,
+            "feature_points": int(on_feature.sum()),
+            "lines": int(line),
+            "area": area,
+            "size": size,
+        }
+        return ScanSamples(
+            points=points, line_id=line_id, face_id=face_id, on_feature=on_feature, meta=meta
         )
-    expected = getattr(shape, "expected", None)
-    meta = {
-        "shape": getattr(shape, "name", type(occ).__name__),
-        "params": dict(getattr(shape, "params", {}) or {}),
-        "expected": None if expected is None else vars(expected).copy(),
-        "spacing": h,
-        "ratio": float(ratio),
-        "directions": dirs.tolist(),
-        "face_directions": [int(f) for f in fam],
-        "jitter": float(jitter),
-        "dropout": float(dropout),
-        "seed": int(seed),
-        "sharp_degrees": float(sharp_degrees),
-        "points": int(points.shape[0]),
-        "repairs": reports,
-        "feature_points": int(on_feature.sum()),
-        "lines": int(line),
-        "area": area,
-        "size": size,
-    }
-    return ScanSamples(
-        points=points, line_id=line_id, face_id=face_id, on_feature=on_feature, meta=meta
-    )
