@@ -111,6 +111,7 @@ class _Arc:
     span: float
     closed: bool
     slides: bool  # its samples slide along it (it bounds a full cylinder)
+    wall: int = -1  # the index of that full cylinder's face, else -1
 
     def distance(self, p: np.ndarray) -> np.ndarray:
         return np.abs(np.linalg.norm(p - self.centre, axis=1) - self.radius)
@@ -141,19 +142,20 @@ def _arcs(face, to2d, across=()) -> list[_Arc]:
     for e in face.Edges():
         if e.geomType() != "CIRCLE":
             continue
-        other = next((f for x, f in across if x.isSame(e)), None)
+        other, wall = next(((f, k) for x, f, k in across if x.isSame(e)), (None, -1))
         slides = other is not None and other.geomType() == "CYLINDER" and _goes_round(other)
+        wall = wall if slides else -1
         c = to2d(np.array([e.arcCenter().toTuple()]))[0]
         r = float(e.radius())
         if e.IsClosed():
-            out.append(_Arc(c, r, 0.0, 2 * math.pi, True, slides))
+            out.append(_Arc(c, r, 0.0, 2 * math.pi, True, slides, wall))
             continue
         s, m, f = (to2d(np.array([e.positionAt(x).toTuple()]))[0] - c for x in (0.0, 0.5, 1.0))
         a0, am, a1 = (math.atan2(q[1], q[0]) for q in (s, m, f))
         span = (a1 - a0) % (2 * math.pi)
         if (am - a0) % (2 * math.pi) > span:  # the arc runs the other way round
             a0, span = a1, 2 * math.pi - span
-        out.append(_Arc(c, r, a0, span, False, slides))
+        out.append(_Arc(c, r, a0, span, False, slides, wall))
     return out
 
 
@@ -387,13 +389,19 @@ def repair_planar_faces(
     arcs are repaired.  Faces are taken in order, each seeing the samples of
     the ones before it as they were left; faces in ``skip`` (laid out
     already, :func:`samplers.disks.lattice_disk_faces`) are left alone.
-    Where the repair of a face bounded by whole circles is stuck with a
+    A full cylinder's rim on a face that is not congruent to the one its
+    other rim lies on (cutcube's hole: one end also has the scoop's arc)
+    takes the other rim's angles and stays, so that the wall is the lattice
+    both rims span (:func:`lattice_cylinder_faces` needs equal angles; the
+    wall kept its scan rows, and cutcube 80 DT_M triangles above √3/2 across
+    the rims).  Where the repair of a face bounded by whole circles is stuck with a
     ratio at or above √3/2, it runs again allowing cells of circumradius up
     to ``RETRY_WIDE`` h, and the lower worst ratio is kept (conebox's top:
     0.879 -> 0.853).  Returns one report per repaired face.
     """
     reports = []
     done: dict[tuple, object] = {}
+    walls: dict[int, np.ndarray] = {}  # a full cylinder's first rim laid: its samples (3-D)
     tol = 1e-7 * size
     adjacency = EdgeFaces(occ)
     nbrs = adjacency.across()
@@ -407,7 +415,7 @@ def repair_planar_faces(
             q = np.asarray(p, dtype=np.float64) - o
             return np.stack([q @ u, q @ v], axis=1)
 
-        arcs = _arcs(face, to2d, [(e, faces[fb]) for e, fb in nbrs[fi] if fb >= 0])
+        arcs = _arcs(face, to2d, [(e, faces[fb], fb) for e, fb in nbrs[fi] if fb >= 0])
         if not arcs and row_dirs is None:
             continue
         seg = _boundary_segments(face, to2d, h / 20)
@@ -459,6 +467,17 @@ def repair_planar_faces(
             frame.round(12).tobytes(),
         )
         if key not in done:
+            # a cylinder whose other rim is laid already: this rim takes its
+            # angles and stays (the wall is then the lattice both rims span)
+            for a in arcs:
+                cur = np.flatnonzero(feat & (a.distance(uv) < tol))
+                if a.wall in walls and cur.size == walls[a.wall].shape[0]:
+                    rec = walls[a.wall]
+                    rec = to2d(rec - np.outer((rec - o) @ n, n))
+                    ang_cur = np.arctan2(*(uv[cur] - a.centre).T[::-1])
+                    ang_rec = np.arctan2(*(rec - a.centre).T[::-1])
+                    uv[cur[np.argsort(ang_cur)]] = rec[np.argsort(ang_rec)]
+                    slide[cur] = False
             sides = _arc_sides(arcs, raster, h)
             clamps = ([_clamp(arcs, sides, h)] if arcs else []) + (
                 [_clamp_lines(lines, h)] if lines else []
@@ -492,6 +511,10 @@ def repair_planar_faces(
             np.where(moved, s.face_id[np.maximum(src, 0)], fi),
             np.where(moved, s.on_feature[np.maximum(src, 0)], False),
         )
+        rim = moved & s.on_feature[np.maximum(src, 0)]
+        for a in arcs:
+            if a.wall >= 0 and a.wall not in walls:
+                walls[a.wall] = pts3[rim & (a.distance(r.uv) < tol)]
         reports.append(
             {
                 "face": fi,

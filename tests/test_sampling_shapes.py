@@ -316,6 +316,26 @@ def test_repairs_are_reported_and_congruent_ends_agree(sampled):
     np.testing.assert_allclose(rim(0.25), rim(-0.25), atol=1e-12)
 
 
+def test_a_holes_rims_agree_when_its_ends_are_unlike(sampled):
+    """cutcube's hole (along y) ends on two faces that differ (one has the
+    scoop's arc too), so their repairs slid the rims apart and the wall kept
+    its scan rows: 80 DT_M triangles across the rims broke III-ii.  The
+    second rim now takes the first one's angles and stays, and the wall is
+    the lattice both rims span."""
+    s, r = sampled["cutcube"]
+    wall = [x for x in r.meta["repairs"] if x["kind"] == "cylinder lattice"]
+    assert len(wall) == 1 and wall[0]["rows"] == round(s.params["side"] / r.meta["spacing"]) - 1
+    p = r.points
+    radius, half = s.params["hole_radius"], s.params["side"] / 2
+
+    def rim(y):
+        on = np.isclose(p[:, 1], y) & np.isclose(np.hypot(p[:, 0], p[:, 2]), radius)
+        return np.sort(np.arctan2(p[on, 2], p[on, 0]))
+
+    assert rim(half).size == wall[0]["columns"]
+    np.testing.assert_allclose(rim(half), rim(-half), atol=1e-12)
+
+
 def test_revolved_body_is_laid_out_in_rings():
     """cone_tip (a cone and a ball meeting smoothly): one ring per meridian step,
     the columns of a ring a subset of the widest ring's, on the surface;
