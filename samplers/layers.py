@@ -684,9 +684,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         fan = _apex_fan(2 * math.pi * sin_a) if rho_l else None
         if fan is not None:  # the ring round the apex becomes the designed fan
             r1 = rho_l[-1][0]
-            rho_l[-1] = r1 * fan.radii
-            ang_l[-1] = (ang_l[-1][0] + 2 * math.pi * fan.at) % (2 * math.pi)
-            row_l[-1] = np.full(fan.radii.size, row_l[-1][0])
+            rho_l[-1], ang_l[-1], row_l[-1] = fan.ring(r1, ang_l[-1][0], row_l[-1][0])
             keep = FAN_KEEP * r1 / t
         nrows = len(rho_l)
         rho_a = np.concatenate(rho_l) if rho_l else np.empty(0)
@@ -771,6 +769,13 @@ class Fan:
 
     radii: np.ndarray
     at: np.ndarray
+
+    def ring(self, radius: float, start: float, row: int):
+        """The ring this fan replaces, of ``radius`` with its first column at
+        angle ``start`` about the axis: per spoke its distance from the apex,
+        its angle and the ring's ``row``."""
+        ang = (start + 2 * math.pi * self.at) % (2 * math.pi)
+        return radius * self.radii, ang, np.full(self.radii.size, row)
 
 
 FAN_CHORD = 0.4  # an uneven fan's neighbouring spoke ends keep this far apart (times t)
@@ -1031,9 +1036,7 @@ def _repair_pole(ring, columns, faces, t: float, end: int):
         fan = _apex_fan(2 * math.pi * sin_a)
         if fan is None:
             return [], [], [], None
-        rho[0] = t * fan.radii
-        ang[0] = (ang[0][0] + 2 * math.pi * fan.at) % (2 * math.pi)
-        row[0] = np.full(fan.radii.size, inner[0])
+        rho[0], ang[0], row[0] = fan.ring(t, ang[0][0], inner[0])
         keep = FAN_KEEP
     rho_a, ang_a, row_a = np.concatenate(rho), np.concatenate(ang), np.concatenate(row)
     r2, a2, row2, bad, worst = _repair_developed(
