@@ -12,9 +12,10 @@ Delaunay triangle meets the condition with a margin:
   shorter than ``0.6 h`` and on triangles whose circumradius exceeds ``h``
   (which keep the spacing and the coverage); the Delaunay triangulation is
   recomputed at every step;
-* samples on a curved boundary edge slide along it (their positions are
-  projected back after each step), samples on straight edges and corners
-  and samples far from the layer stay fixed;
+* samples on a boundary edge may slide along it (their positions are
+  projected back after each step), keeping their spacing from one another
+  and from the edge's corners (``anchors``); other samples on edges,
+  corners and samples far from the layer stay fixed;
 * where the descent is stuck, one sample of a bad triangle is removed or a
   sample is added at its centroid, whichever helps most after a short local
   descent (candidates in a fixed order, so the result is deterministic);
@@ -97,10 +98,16 @@ class _Problem:
         judge_frame=False,
         turn=None,
         wide=WIDE,
+        anchor=None,
     ):
         self.uv = np.asarray(uv, dtype=np.float64).copy()
         self.free = np.asarray(free, dtype=bool).copy()
         self.slide = np.asarray(slide, dtype=bool).copy()
+        self.anchor = (
+            np.zeros(self.uv.shape[0], dtype=bool)
+            if anchor is None
+            else np.asarray(anchor, dtype=bool).copy()
+        )
         self.origin = np.arange(self.uv.shape[0])
         self.project = project
         self.inside = inside
@@ -173,10 +180,11 @@ class _Problem:
     def copy(self) -> _Problem:
         c = _Problem.__new__(_Problem)
         c.__dict__.update(self.__dict__)
-        c.uv, c.free, c.slide, c.origin = (
+        c.uv, c.free, c.slide, c.anchor, c.origin = (
             self.uv.copy(),
             self.free.copy(),
             self.slide.copy(),
+            self.anchor.copy(),
             self.origin.copy(),
         )
         c._watch = None
@@ -268,10 +276,15 @@ def _energy(prob: _Problem, subset=None, active=None):
     energy += float((short**2).sum()) / 2.0  # each interior edge is seen twice
     for col in range(3):
         push(np.full(tri.shape[0], col), -short[:, col] / h)
-    # samples sliding along one edge keep their spacing within [0.75 h, 1.35 h]:
-    # the lattice of the face on the other side starts from them
+    # samples sliding along one edge keep their spacing within [0.75 h, 1.35 h]
+    # (and from the anchors, the fixed corners ending their runs): the
+    # lattice of the face on the other side starts from them
     ends = of[tri[:, _EDGES]]  # (m, 3, 2) sample ids of every edge's ends
-    both = ((ends >= 0) & prob.slide[np.maximum(ends, 0)]).all(axis=2)
+    real_ends = ends >= 0
+    ids = np.maximum(ends, 0)
+    both = (real_ends & (prob.slide | prob.anchor)[ids]).all(axis=2) & ~(
+        real_ends & prob.anchor[ids]
+    ).all(axis=2)
     if both.any():
         gap = (
             np.where(
@@ -386,6 +399,7 @@ def repair(
     judge_frame: bool = False,
     turn: float | None = None,
     wide: float = WIDE,
+    anchors=None,
     descent_steps: int = 300,
     max_edits: int | None = None,
 ) -> Repaired:
@@ -436,6 +450,10 @@ def repair(
     wide : float
         Circumradii above this (times ``h``) are penalised (a larger bound
         lets the descent leave wider cells where the default one is stuck).
+    anchors : (n,) array_like of bool, optional
+        Fixed samples that end a run of sliding ones (a straight edge's
+        corners): the spacing between them and their sliding neighbours is
+        kept within ``GAP`` too, like that between sliding neighbours.
     descent_steps, max_edits : int
         Work limits (``max_edits`` defaults to an eighth of the movable
         samples, at least 80).
@@ -482,6 +500,7 @@ def repair(
         judge_frame,
         turn,
         wide,
+        None if anchors is None else np.asarray(anchors, dtype=bool)[sub],
     )
     _descend(prob, descent_steps)
     nbad, _, bad, worst = _status(prob)
@@ -531,6 +550,7 @@ def _edited(prob: _Problem, edits) -> _Problem:
     trial.uv = np.vstack([trial.uv[keep], *[trial.wrap(a[None]) for a in add]])
     trial.free = np.r_[trial.free[keep], np.ones(len(add), dtype=bool)]
     trial.slide = np.r_[trial.slide[keep], np.zeros(len(add), dtype=bool)]
+    trial.anchor = np.r_[trial.anchor[keep], np.zeros(len(add), dtype=bool)]
     trial.origin = np.r_[trial.origin[keep], np.full(len(add), -1)]
     return trial
 

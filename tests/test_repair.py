@@ -210,3 +210,31 @@ def test_a_cone_development_is_repaired_across_its_glued_sides():
     fixed = out.origin >= 0
     fixed[fixed] = ~free[out.origin[fixed]]
     np.testing.assert_array_equal(out.uv[fixed], uv[out.origin[fixed]])
+
+
+def test_anchors_keep_the_gap_from_a_corner():
+    """Samples sliding along a straight edge keep 0.75 h from their sliding
+    neighbours; with the edge's fixed corners as anchors they keep it from
+    the corners too (the first column of the face whose columns follow
+    them starts there): a first sample 0.45 h from its corner moves out to
+    0.75 h, and stays nearer than 0.6 h without the anchors."""
+    h = 1.0
+    rows = np.stack(np.meshgrid(np.arange(11.0), np.arange(1.0, 6.0)), -1).reshape(-1, 2)
+    edge = np.c_[np.r_[0.0, np.arange(0.45, 9.5, 1.0), 10.0], np.zeros(12)]
+    uv = np.vstack([edge, rows])
+    slide = np.zeros(len(uv), bool)
+    slide[1:11] = True
+    anchors = np.zeros(len(uv), bool)
+    anchors[[0, 11]] = True
+
+    def project(q):
+        return np.c_[np.clip(q[:, 0], 0.3, 9.7), np.zeros(len(q))]
+
+    def first_gap(**kw):
+        r = repair(uv, np.zeros(len(uv), bool), h, slide=slide, project=project, **kw)
+        x = np.sort(r.uv[np.abs(r.uv[:, 1]) < 1e-12, 0])
+        assert x.size == 12  # nothing on the edge added or removed
+        return x[1] - x[0]
+
+    assert first_gap() < 0.6 * h
+    assert first_gap(anchors=anchors) > 0.74 * h

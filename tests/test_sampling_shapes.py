@@ -114,50 +114,65 @@ def test_cone_rim_stays_evenly_spaced(sampled):
     np.testing.assert_allclose(gap, 2 * np.pi / on.sum(), rtol=1e-9)
 
 
-def test_rows_parallel_to_a_slanted_edge_share_its_lattice(sampled):
-    """A star prism's sides run along no axis: their rows take the samples of
-    the sides' horizontal edges as columns (they once staggered against them
-    by a fraction of a step: 14.5% of the samples broke Condition III-ii).
-    The corners stay where they are, off that lattice; an end gap wider than
-    1.5 h gets a sample in its middle, on the edge and on every row alike
-    (a reflex edge's first column once stood 1.8 h off it)."""
-    s, r = sampled["star_prism"]
+def _side_edge_positions(face, p, on_feature, h):
+    """A prism side's horizontal edges (slanted to every axis): the arc
+    lengths, from the top edge's start, of the samples on each (corners
+    excluded), the edges' length and direction, and the start."""
+    edges = [e for e in face.Edges() if abs(e.tangentAt(0.5).z) < 1e-9]
+    top = max(edges, key=lambda e: e.Center().z)
+    a = np.array(top.startPoint().toTuple())
+    u = np.array(top.endPoint().toTuple()) - a
+    length = np.linalg.norm(u)
+    u /= length
+    if np.abs(u[:2]).min() < 1e-9:
+        return None  # along an axis: the end's rows cross it, nothing slides
+    out = []
+    for e in sorted(edges, key=lambda e: -e.Center().z):
+        z = e.Center().z
+        t = (p - a) @ u
+        foot = a + t[:, None] * u
+        foot[:, 2] = z
+        on = on_feature & (np.linalg.norm(p - foot, axis=1) < 1e-9)
+        out.append(np.sort(t[on & (t > 1e-9) & (t < length - 1e-9)]))
+    return out, length, u, a
+
+
+@pytest.mark.parametrize("name, count", [("star_prism", 10), ("wedge", 2)])
+def test_sides_columns_follow_their_ends_slid_edge_samples(sampled, name, count):
+    """A star prism's and a wedge's sides run along no axis: their rows take
+    the samples of their horizontal edges as columns.  Those edges are
+    slanted to the ends' rows, and the ends' layer repair slides their
+    samples (the wedge's 30° corner had an isosceles triangle there, ratio
+    1.0, and a ladder of equal rungs in its narrow strip): the sides'
+    columns follow, so every row sample of a side lies at the arc length of
+    one of its edge samples, the top edge's equal the bottom's (the two ends
+    get one answer), and the gaps, from the corners too, stay between 0.6 h
+    and 1.6 h (the repair's soft bounds are 0.75 h and 1.35 h; the star's
+    crossings were 1.35 h apart; 0.81 h to 1.46 h measured), where a side's
+    cells keep their ratio below √3/2.  The samples moved off the
+    crossings' lattice."""
+    s, r = sampled[name]
     p, h = r.points, r.meta["spacing"]
-    sides = split = 0
+    sides = moved = 0
     for fi, face in enumerate(s.solid.Faces()):
         n = np.array(face.normalAt().toTuple())
         if abs(n[2]) > 1e-9:
-            continue  # the two star-shaped ends
+            continue  # the two ends
+        got = _side_edge_positions(face, p, r.on_feature, h)
+        if got is None:
+            continue
+        (top, bottom), length, u, a = got
         sides += 1
-        edge = next(e for e in face.Edges() if abs(e.tangentAt(0.5).z) < 1e-9)
-        a = np.array(edge.startPoint().toTuple())
-        u = np.array(edge.endPoint().toTuple()) - a
-        length = np.linalg.norm(u)
-        u /= length
-        # the edge's own samples (where the star end's lattice lines cross it)
-        t = (p - a) @ u
-        on = r.on_feature & (np.linalg.norm(p - a - t[:, None] * u, axis=1) < 1e-9)
-        q = np.sort(t[on & (t > 1e-9) & (t < length - 1e-9)])
-        inner = q[1:-1]
-        step = inner[1] - inner[0]
-        np.testing.assert_allclose(np.diff(inner), step, rtol=1e-9)
-        # the end gaps: a lattice gap, or half of one wider than 1.5 h
-        ends = np.array([q[0], length - q[-1]])
-        assert (ends >= 0.75 * h - 1e-9).all() and (ends <= 1.5 * h + step).all()
-        halves = [q[1] - q[0], q[-1] - q[-2]]
-        split += sum(abs(g - step) > 1e-9 for g in halves)
-        for g, e in zip(halves, ends):
-            assert abs(g - step) < 1e-9 or abs(g - e) < 1e-9
-        # every row sample is on the edge's lattice or at one of the edge's
-        # end samples' positions (a gap-filling sample, line -2, may sit
-        # between a column and a corner)
-        tf = t[(r.face_id == fi) & (r.line_id >= 0) & (t > 1e-9) & (t < length - 1e-9)]
-        k = (tf - inner[0]) / step
-        assert tf.size > 100
-        off = np.abs(k - np.round(k)) > 1e-6
-        assert np.isclose(tf[off][:, None], q[[0, -1]][None], atol=1e-9).any(axis=1).all()
-    assert sides == 10
-    assert split > 0
+        np.testing.assert_allclose(top, bottom, atol=1e-9 * length)
+        gaps = np.diff(np.r_[0.0, top, length])
+        assert gaps.min() > 0.6 * h and gaps.max() < 1.6 * h
+        moved += int(np.ptp(np.diff(top)) > 1e-6 * h)
+        t = (p[(r.face_id == fi) & (r.line_id >= 0)] - a) @ u
+        t = t[(t > 1e-9) & (t < length - 1e-9)]
+        assert t.size > 50
+        assert np.abs(t[:, None] - top[None]).min(axis=1).max() < 1e-9 * length
+    assert sides == count
+    assert moved == count
 
 
 def lateral_edge_samples(solid, r):
@@ -437,7 +452,9 @@ def test_round_faces_are_rings_without_bad_triangles(sampled, name):
         np.testing.assert_allclose(rims[0], rims[1], atol=1e-12)
 
 
-@pytest.mark.parametrize("name", ["square_ring", "cone", "block_two_holes", "cone_tip", "conebox"])
+@pytest.mark.parametrize(
+    "name", ["square_ring", "cone", "block_two_holes", "cone_tip", "conebox", "wedge"]
+)
 def test_shapes_meet_condition_iii(checked, name):
     """No sample breaks Condition III by the geodesic check: every sample in
     a DT_M triangle (none left out, as a cone's apex was when its cell's
@@ -449,7 +466,8 @@ def test_shapes_meet_condition_iii(checked, name):
     spokes round its apex (worst 0.863); conebox: its cone's stuck ring
     repair run again over a wider band, its top's stuck boundary layer
     again with wider cells allowed (worst 0.865; 0.29% of the samples
-    violating without either)."""
+    violating without either); wedge: its ends' edge samples slide and its
+    sides' columns follow (worst 0.828; 1.20% violating with them fixed)."""
     rep = checked(name)
     assert rep.max_degree <= 33
     assert np.all(rep.worst_ratio < np.sqrt(3) / 2)
@@ -505,15 +523,21 @@ def test_ring_laid_shapes_reconstruct_with_their_topology(sampled, name):
 
 def test_slanted_edge_layers_are_edited(sampled):
     """The wedge's two triangular ends meet their sides along edges slanted
-    15 degrees to the rows: relaxing that layer alone leaves 86 triangles
-    above the repair's margin (counting those across the edges, on the
-    sides' samples); removals and insertions (at most 40 a face) leave
-    fewer than 60 (53 measured)."""
+    15 degrees to the rows, whose samples slide: the two ends get one
+    answer (reported for each; one end has a gap-filling sample more),
+    with removals and insertions (at most 160 a face), and no triangle is
+    left above the repair's margin (86 were, relaxing the layer alone with
+    the edge samples fixed)."""
+    from samplers.layers import FOLLOW_EDITS
+
     _, r = sampled["wedge"]
     planes = [x for x in r.meta["repairs"] if x["kind"] == "plane"]
     assert len(planes) == 2
-    assert all(0 < x["added"] + x["removed"] <= 40 for x in planes)
-    assert sum(x["bad"] for x in planes) < 60
+    # one answer: the same samples after it (one end had a gap-filling sample more)
+    kept = [(x["samples"] - x["removed"], x["added"], x["bad"], x["worst"]) for x in planes]
+    assert kept[0] == kept[1]
+    assert all(0 < x["added"] + x["removed"] <= FOLLOW_EDITS for x in planes)
+    assert sum(x["bad"] for x in planes) == 0
 
 
 def test_apex_fans_meet_condition_iii_with_their_spokes_delaunay():
