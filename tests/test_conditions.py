@@ -234,7 +234,7 @@ def test_edges_plainly_not_delaunay_are_flipped(height, crossings, flipped):
     flips it to (c, d) when the angles at c and d exceed π by more than
     FLIP_MARGIN (a labelling error where samples crowd, as round a cone's
     designed fan), or by anything on a near tie; a Delaunay edge stays."""
-    from validators.conditions import FLIP_MARGIN, _flip_near_ties
+    from validators.conditions import FLIP_MARGIN, _flip_to_delaunay
 
     assert FLIP_MARGIN == 5.0
     pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, height], [0.5, -height]])
@@ -245,7 +245,7 @@ def test_edges_plainly_not_delaunay_are_flipped(height, crossings, flipped):
     def geodesics(pairs):
         return np.linalg.norm(pts[pairs[:, 0]] - pts[pairs[:, 1]], axis=1)
 
-    e, _, t = _flip_near_ties(pts, (edges, cross, tri), geodesics)
+    e, _, t = _flip_to_delaunay(pts, (edges, cross, tri), geodesics)
     got = {tuple(x) for x in e.tolist()}
     assert ((2, 3) in got, (0, 1) in got) == (flipped, not flipped)
     assert len(got) == 5

@@ -467,7 +467,7 @@ def _angle(x, y, z) -> np.ndarray:
     return np.arccos(np.clip((x * x + y * y - z * z) / (2.0 * x * y), -1.0, 1.0))
 
 
-def _flip_near_ties(pts, dt, geodesics: _Geodesics, rounds: int = 8):
+def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8):
     """Decide the near ties of DT_M, and mend the labels' plain errors, by
     the intrinsic Delaunay criterion.
 
@@ -556,7 +556,7 @@ def sample_conditions(
     triangle (a cell whose corners fell between the truth's vertices) is
     labelled again finer round it (:func:`_settle`), and a near tie (four
     samples nearly on one circle) takes the diagonal of the intrinsic
-    Delaunay angle test (:func:`_flip_near_ties`), as does any edge whose
+    Delaunay angle test (:func:`_flip_to_delaunay`), as does any edge whose
     opposite angles exceed π by more than ``FLIP_MARGIN`` (where samples
     crowd, Dijkstra's labels can be plainly wrong).  Geodesic lengths of
     DT_M edges are exact mesh geodesics (potpourri3d's edge-flip solver)
@@ -579,7 +579,7 @@ def sample_conditions(
     flip_ties : bool
         Decide near ties (four samples within about the resolution of one
         circle), and edges plainly not Delaunay, by the intrinsic Delaunay
-        angle test on geodesic lengths (:func:`_flip_near_ties`) instead of
+        angle test on geodesic lengths (:func:`_flip_to_delaunay`) instead of
         by the labels alone.
     quiet : bool
         No progress bar over the traced geodesics (shown only when stderr is
@@ -620,7 +620,7 @@ def sample_conditions(
         geodesics(dt_edges)  # every DT_M edge's length, in one pass
     if flip_ties:
         with timed("conditions: angle test"):
-            dt_edges, crossings, dt_tri = _flip_near_ties(
+            dt_edges, crossings, dt_tri = _flip_to_delaunay(
                 pts, (dt_edges, crossings, dt_tri), geodesics
             )
     length = geodesics(dt_edges)
