@@ -346,6 +346,19 @@ def _parallel_rows(face, row_dir, u: np.ndarray) -> bool:
     return n >= 1e-9 and abs(float(u @ rows)) / n > 1 - 1e-6
 
 
+def _plain_lattice(face, row_dir) -> bool:
+    """Whether a planar face is bounded by straight edges along or across its
+    rows only: its samples are the plain lattice, which no repair touches
+    (so its columns may follow its edges' samples afterwards)."""
+    for e in face.Edges():
+        if e.geomType() != "LINE":
+            return False
+        u = np.array(e.endPoint().toTuple()) - np.array(e.startPoint().toTuple())
+        if _slanted(face, row_dir, u / np.linalg.norm(u)):
+            return False
+    return True
+
+
 def _slanted_lines(occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs) -> list[_Line]:
     """Sharp straight edges of a planar face, between it and another planar
     face, neither parallel nor perpendicular to the face's scan rows (those
@@ -353,9 +366,10 @@ def _slanted_lines(occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs) -
     within ``LAYER`` h of the edge unfolded into this face's plane (exact for
     a polyhedral edge: geodesics across it unfold to straight lines).  An
     edge slanted to the other face's rows too slides.  One parallel to them
-    holds the ends of that face's columns: its samples slide too (``follows``),
-    and the columns follow them afterwards (:func:`_follow_columns`).  One
-    perpendicular to them holds the ends of that face's rows and stays."""
+    holds the ends of that face's columns: where that face is a plain
+    lattice (:func:`_plain_lattice`), its samples slide too (``follows``),
+    and the columns follow them afterwards (:func:`_follow_columns`).  Any
+    other holds the ends of that face's rows or columns and stays."""
     n = np.array(face.normalAt().toTuple())
     faces = occ.Faces()
     out = []
@@ -384,7 +398,11 @@ def _slanted_lines(occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs) -
         unfolded = foot[near] - dist[near, None] * m3
         frame = to2d(unfolded) if near.any() else np.empty((0, 2))
         slides = _slanted(faces[fb], np.asarray(row_dirs[fb]), u)
-        follows = not slides and _parallel_rows(faces[fb], np.asarray(row_dirs[fb]), u)
+        follows = (
+            not slides
+            and _parallel_rows(faces[fb], np.asarray(row_dirs[fb]), u)
+            and _plain_lattice(faces[fb], np.asarray(row_dirs[fb]))
+        )
         out.append(_Line(a2, b2, m, frame, slides, follows, np.stack([a3, b3]), fb))
     return out
 
