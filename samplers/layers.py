@@ -463,12 +463,13 @@ def repair_planar_faces(
     That last case is a prism's ends, a wedge's or a star prism's: with the
     edge samples fixed, the wedge's 30° corner held an isosceles triangle
     (ratio 1.0) and a ladder of equal rungs, and 1.20% of its samples broke
-    III-ii (star prism 2.93%); sliding, none do (star prism 0.12%).  Corners and other
-    samples on straight edges stay.  ``row_dirs`` (per face, the normal of
-    its scan planes) tells which straight edges are slanted; without it only
-    arcs are repaired.  Faces are taken in order, each seeing the samples of
-    the ones before it as they were left; faces in ``skip`` (laid out
-    already, :func:`samplers.disks.lattice_disk_faces`) are left alone.
+    III-ii (star prism 2.93%); sliding, none do (star prism 0.12%).
+    Corners and other samples on straight edges stay.  ``row_dirs`` (per
+    face, the normal of its scan planes) tells which straight edges are
+    slanted; without it only arcs are repaired.  Faces are taken in order,
+    each seeing the samples of the ones before it as they were left; faces
+    in ``skip`` (laid out already, :func:`samplers.disks.lattice_disk_faces`)
+    are left alone.
     A full cylinder's rim on a face that is not congruent to the one its
     other rim lies on (cutcube's hole: one end also has the scoop's arc)
     takes the other rim's angles and stays, so that the wall is the lattice
