@@ -31,6 +31,7 @@ from validators.conditions import SQRT3_2
 
 from .adjacency import EdgeFaces
 from .repair import GAP, MOVABLE, Repaired, copies, repair
+from .scanline import row_cosine
 
 LAYER = 2.5  # samples within this many h of a circular edge may move
 RASTER = 8  # inside tests on a grid of h / RASTER
@@ -332,18 +333,14 @@ class _Line:
 def _slanted(face, row_dir, u: np.ndarray) -> bool:
     """Whether the direction ``u`` (in the plane of ``face``) is neither
     parallel nor perpendicular to the face's scan rows."""
-    rows = np.cross(np.array(face.normalAt().toTuple()), row_dir)
-    if np.linalg.norm(rows) < 1e-9:
-        return False
-    c = abs(float(u @ rows)) / float(np.linalg.norm(rows))
-    return 1e-6 <= c <= 1 - 1e-6
+    c = row_cosine(face, row_dir, u)
+    return c is not None and 1e-6 <= c <= 1 - 1e-6
 
 
 def _parallel_rows(face, row_dir, u: np.ndarray) -> bool:
     """Whether the direction ``u`` (in the plane of ``face``) runs along the face's scan rows."""
-    rows = np.cross(np.array(face.normalAt().toTuple()), row_dir)
-    n = float(np.linalg.norm(rows))
-    return n >= 1e-9 and abs(float(u @ rows)) / n > 1 - 1e-6
+    c = row_cosine(face, row_dir, u)
+    return c is not None and c > 1 - 1e-6
 
 
 def _step_fits(s: Samples, a3: np.ndarray, u: np.ndarray, length: float, h: float) -> bool:
@@ -353,8 +350,9 @@ def _step_fits(s: Samples, a3: np.ndarray, u: np.ndarray, length: float, h: floa
     rows cross its sides' edges 1.43 h apart), the repair squeezes most gaps
     to that bound and leaves the excess in a few gaps of 2 h, whose columns
     break III-ii all along the face they follow (7.9% of the samples)."""
-    t = (s.points[s.on_feature] - a3) @ u
-    off = np.linalg.norm(s.points[s.on_feature] - a3 - t[:, None] * u, axis=1)
+    q = s.points[s.on_feature] - a3
+    t = q @ u
+    off = np.linalg.norm(q - t[:, None] * u, axis=1)
     t = np.sort(t[(off < 1e-6 * h) & (t > 1e-9 * length) & (t < length * (1 - 1e-9))])
     return t.size < 3 or float(np.diff(t).max()) <= GAP[1] * h
 
@@ -618,9 +616,9 @@ def repair_planar_faces(
         src = np.where(r.origin >= 0, idx[np.maximum(r.origin, 0)], -1)
         moved = src >= 0
         pts3 = o + r.uv[:, :1] * u + r.uv[:, 1:] * v
+        slid = np.flatnonzero(moved & slide[np.maximum(r.origin, 0)])
         for ln in follow:
-            rows = np.flatnonzero(moved & slide[np.maximum(r.origin, 0)])
-            rows = rows[ln.distance(r.uv[rows]) < tol]
+            rows = slid[ln.distance(r.uv[slid]) < tol]
             a3, b3 = ln.ends3
             length = float(np.linalg.norm(b3 - a3))
             u3 = (b3 - a3) / length
@@ -683,7 +681,7 @@ def _follow_columns(s: Samples, shifts: dict[int, list], faces, tol: float) -> N
     straight line between its two ends.
     """
     for fb, records in shifts.items():
-        _, _, _, n = _plane_frame(faces[fb])
+        n = np.array(faces[fb].normalAt().toTuple())
         corners = np.array([q.toTuple() for q in faces[fb].Vertices()])
         o = corners[0]
         sel = np.flatnonzero((s.face_id == fb) & ~s.on_feature & (np.abs((s.points - o) @ n) < tol))

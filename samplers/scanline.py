@@ -462,6 +462,15 @@ def _columns(face, d, hf, ratio, anchor, axis_steps):
     return rows, float(anchor @ rows), ratio * hf
 
 
+def row_cosine(face, row_dir, u: np.ndarray) -> float | None:
+    """|cos| of the angle between the direction ``u`` (in the plane of
+    ``face``) and the face's scan rows (those of the planes with normal
+    ``row_dir``); None where the planes run along the face (no rows)."""
+    rows = np.cross(np.array(face.normalAt().toTuple()), row_dir)
+    n = float(np.linalg.norm(rows))
+    return None if n < 1e-9 else abs(float(u @ rows)) / n
+
+
 def _row_crossings(a, u, length, adjacent, faces, planes, step):
     """Where the lattice lines of an adjacent planar face (``adjacent``:
     indices into ``faces``) cross a straight edge slanted to that face's
@@ -485,11 +494,8 @@ def _row_crossings(a, u, length, adjacent, faces, planes, step):
         if f.geomType() != "PLANE":
             continue
         d, t0, hf, columns = planes[fi]
-        rows = np.cross(np.array(f.normalAt().toTuple()), d)
-        if np.linalg.norm(rows) < 1e-9:
-            continue
-        along = abs(float(u @ rows)) / float(np.linalg.norm(rows))
-        if along < 1e-6 or along > 1 - 1e-6:
+        along = row_cosine(f, d, u)
+        if along is None or along < 1e-6 or along > 1 - 1e-6:
             continue  # rows parallel or perpendicular to the edge: equal steps fit
         for normal, offset, gap in [(d, t0, hf)] + ([columns] if columns else []):
             un = float(u @ normal)
