@@ -159,6 +159,13 @@ def _exact_bounds(shape) -> tuple[np.ndarray, np.ndarray]:
     return np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
 
 
+def _box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The 8 corners of the box ``[lo, hi]`` (x slowest, z fastest)."""
+    return np.array(
+        [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+    )
+
+
 def _dividing_step(extent: float, h: float) -> float:
     """The spacing nearest ``h`` that divides ``extent`` into whole steps."""
     return extent / max(1, round(extent / h)) if extent > 0 else h
@@ -732,9 +739,7 @@ def scan(
             )
         tol = 1e-7 * size
         fam = [_face_family(f, dirs, size / 200) for f in faces]
-        corner = np.array(
-            [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
-        )
+        corner = _box_corners(lo, hi)
 
         # rows along a coordinate axis: r times that axis's plane spacing
         axis_steps = ratio * np.array([_dividing_step(float(e), h) for e in hi - lo])
@@ -759,16 +764,7 @@ def scan(
             pbar.update(1)
             d, t0, hf, _ = planes[fi]
             sphere = _sphere_frame(face, d)
-            flo, fhi = _exact_bounds(face)
-            fc = np.array(
-                [
-                    [x, y, z]
-                    for x in (flo[0], fhi[0])
-                    for y in (flo[1], fhi[1])
-                    for z in (flo[2], fhi[2])
-                ]
-            )
-            proj = fc @ d
+            proj = _box_corners(*_exact_bounds(face)) @ d
             j0 = math.ceil((proj.min() - t0) / hf - 1e-9)
             j1 = math.floor((proj.max() - t0) / hf + 1e-9)
             for j in range(j0, j1 + 1):
