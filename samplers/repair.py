@@ -19,7 +19,10 @@ Delaunay triangle meets the condition with a margin:
 * where the descent is stuck, one sample of a bad triangle is removed or a
   sample is added at its centroid, whichever helps most after a short local
   descent (candidates in a fixed order, so the result is deterministic);
-  bad triangles far apart (``SEPARATION``) are edited in the same round.
+  bad triangles far apart (``SEPARATION``) are edited in the same round;
+* :func:`split_corners`, for a face left with a few bad triangles at a
+  fixed corner: a sample added on the corner's bisector, and the repair
+  run again.
 
 The domain is 2-D (a planar face in plane coordinates).  Everything is
 plain numpy and scipy's Delaunay; no randomness.
@@ -33,6 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
+from validators.conditions import SQRT3_2
+
 TARGET = 0.78  # the descent pushes every ratio below this
 BAD = 0.83  # a triangle above this still needs work (margin below sqrt(3)/2)
 SHORT = 0.6  # edges shorter than this (times h) are penalised
@@ -43,6 +48,8 @@ SEPARATION = 12.0  # bad triangles edited at once are this far apart, times h
 MOVABLE = 3.0  # a layout's samples this near (times h) a defect it repairs may move
 REACH = 4.0  # in a local descent, triangles with a longer edge (times h) join two regions
 IMAGE_BAND = 4.0  # samples this near (times h) a glued side of a development get an image
+CORNER_DISTANCES = (0.7, 0.85, 1.0)  # a sample added on a corner's bisector this far, times h
+CORNER_ROUNDS = 4  # corners split one after another, at most this many
 _EDGES = np.array([[0, 1], [1, 2], [2, 0]])
 GHOST, FRAME = -1, -2  # the sample id of a ghost point and of a frame point
 
@@ -623,4 +630,103 @@ def _best_edits(prob: _Problem, regions, skip: set) -> list[tuple[tuple, np.ndar
             skip.add(_key(regions[g][1]))
         else:
             out.append((b[1], regions[g][1]))
+    return out
+
+
+def _corner_wedge(r: Repaired, fixed: np.ndarray, inside) -> tuple[int, np.ndarray] | None:
+    """The fixed sample of the worst Delaunay triangle of ``r`` at or above
+    √3/2 that has one (the first such corner in the triangle's order), and
+    the unit bisector of the triangle's angle there; None without such a
+    triangle."""
+    if r.uv.shape[0] < 3:
+        return None
+    try:
+        tri = Delaunay(r.uv).simplices
+    except QhullError:
+        return None
+    tri = tri[inside(r.uv[tri].mean(axis=1))]
+    p = r.uv[tri]
+    length = np.sort(np.linalg.norm(p - p[:, [1, 2, 0]], axis=2), axis=1)
+    rho = length[:, 1] / length[:, 2]
+    for t in np.flatnonzero(rho >= SQRT3_2)[np.argsort(-rho[rho >= SQRT3_2], kind="stable")]:
+        for k in range(3):
+            v = int(tri[t, k])
+            if fixed[v]:
+                a, b = r.uv[tri[t, (k + 1) % 3]] - r.uv[v], r.uv[tri[t, (k + 2) % 3]] - r.uv[v]
+                half = a / np.linalg.norm(a) + b / np.linalg.norm(b)
+                return v, half / np.linalg.norm(half)
+    return None
+
+
+def split_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
+    """Split the angle at a fixed sample of a triangle left breaking Condition III-ii.
+
+    :func:`repair` edits a stuck triangle by removing one of its free
+    samples or adding one at its centroid.  Neither helps where the
+    triangle's fixed corner opens wide into the face: a star prism's reflex
+    corner, 247° round the end cap, was left with a triangle of 70° there
+    whose two sides along the edge and the row (0.75 h and 1.7 h) made the
+    ratio 0.94.  Every triangle of Condition III-ii has its middle angle
+    below 60° (sin(middle) / sin(largest) < √3/2), so such an angle wants a
+    sample inside it.  Here the worst triangle at or above √3/2 with a
+    fixed sample (a corner, an edge's sample) gets a new free sample on the
+    bisector of its angle there, at each of
+    ``CORNER_DISTANCES`` h in turn; the repair runs again on each and the
+    best answer (lowest worst ratio, then fewest bad triangles) is kept if
+    it beats the one before.  Up to ``CORNER_ROUNDS`` angles are split, one
+    after another.
+
+    Parameters
+    ----------
+    uv, free, h
+        The input of ``first``'s :func:`repair`.
+    first : Repaired
+        Its answer.
+    **kwargs
+        The keyword arguments of that repair (``slide``, ``anchors``,
+        ``inside``, ...), passed on to the new ones.
+
+    Returns
+    -------
+    Repaired
+        ``first``, or a better answer whose ``origin`` refers to ``uv``.
+    """
+    uv = np.asarray(uv, dtype=np.float64)
+    n = uv.shape[0]
+    free = np.asarray(free, dtype=bool)
+    slide = kwargs.pop("slide", None)
+    slide = np.zeros(n, dtype=bool) if slide is None else np.asarray(slide, dtype=bool)
+    anchors = kwargs.pop("anchors", None)
+    anchors = np.zeros(n, dtype=bool) if anchors is None else np.asarray(anchors, dtype=bool)
+    inside = kwargs.get("inside") or (lambda c: np.ones(c.shape[0], dtype=bool))
+    out = first
+    for _ in range(CORNER_ROUNDS):
+        if out.worst < SQRT3_2:
+            break
+        was = np.where(out.origin >= 0, out.origin, n)  # n: a sample some repair added
+        fixed = ~np.r_[free | slide, True][was]
+        corner = _corner_wedge(out, fixed, inside)
+        if corner is None:
+            break
+        v, half = corner
+        best = None
+        for distance in CORNER_DISTANCES:
+            new = out.uv[v] + distance * h * half
+            if not inside(new[None])[0]:
+                continue
+            grown = np.r_[was, n]
+            trial = repair(
+                np.vstack([out.uv, new]),
+                ~np.r_[~free, False][grown],
+                h,
+                slide=np.r_[slide, False][grown],
+                anchors=np.r_[anchors, False][grown],
+                **kwargs,
+            )
+            if best is None or (trial.worst, trial.bad) < (best.worst, best.bad):
+                best = trial
+        if best is None or best.worst >= out.worst:
+            break
+        origin = np.r_[out.origin, -1][np.where(best.origin >= 0, best.origin, out.uv.shape[0])]
+        out = Repaired(uv=best.uv, origin=origin, bad=best.bad, worst=best.worst)
     return out

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial import Delaunay, cKDTree
 
-from samplers.repair import BAD, repair, rotate
+from samplers.repair import BAD, repair, rotate, split_corners
 
 
 def hole_layout(h, radius, centre):
@@ -238,3 +238,40 @@ def test_anchors_keep_the_gap_from_a_corner():
 
     assert first_gap() < 0.6 * h
     assert first_gap(anchors=anchors) > 0.74 * h
+
+
+def test_split_corners_mends_an_angle_the_edits_cannot():
+    """A face round a fixed corner 247° wide (a star prism's reflex corner:
+    its edges leave at 69.7° and 182.3°), a square lattice kept 0.75 h off
+    both edges, the edges' samples h apart and fixed, the lattice within
+    2.5 h of them free: the repair is stuck at a ratio of √3/2 or more; with
+    a sample added on the bisector of a fixed sample's angle and the repair
+    run again, every triangle is below √3/2.  The fixed samples stay where
+    they were, and the answer is the same every time."""
+    edges = np.radians([69.7, 182.3])
+    dirs = np.stack([np.cos(edges), np.sin(edges)], 1)
+
+    def inside(q):
+        ang = np.degrees(np.arctan2(q[:, 1], q[:, 0])) % 360.0
+        return ~((ang > 69.7) & (ang < 182.3)) & (np.abs(q).max(axis=1) < 6.5)
+
+    def off_edges(q):
+        t = np.clip(q @ dirs.T, 0.0, None)  # (k, 2): along each edge
+        return np.min(np.linalg.norm(q[:, None] - t[..., None] * dirs, axis=2), axis=1)
+
+    g = np.stack(np.meshgrid(np.arange(-6.0, 7.0), np.arange(-6.0, 7.0)), -1).reshape(-1, 2)
+    g = g[inside(g) & (off_edges(g) > 0.75) & (np.linalg.norm(g, axis=1) > 0.5)]
+    on_edges = np.array([k * d for d in dirs for k in range(1, 7) if np.abs(k * d).max() < 6.5])
+    uv = np.vstack([[(0.0, 0.0)], on_edges, g])
+    fixed = 1 + len(on_edges)
+    free = np.r_[np.zeros(fixed, bool), off_edges(g) < 2.5]
+    first = repair(uv, free, 1.0, inside=inside)
+    assert ratios(first.uv, inside).max() >= np.sqrt(3) / 2
+    split = split_corners(uv, free, 1.0, first, inside=inside)
+    assert split.worst < np.sqrt(3) / 2
+    assert ratios(split.uv, inside).max() < np.sqrt(3) / 2
+    kept = np.flatnonzero((split.origin >= 0) & (split.origin < fixed))
+    assert np.array_equal(np.sort(split.origin[kept]), np.arange(fixed))
+    assert np.array_equal(split.uv[kept], uv[split.origin[kept]])
+    again = split_corners(uv, free, 1.0, first, inside=inside)
+    assert np.array_equal(again.uv, split.uv) and np.array_equal(again.origin, split.origin)
