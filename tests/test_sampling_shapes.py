@@ -454,7 +454,16 @@ def test_round_faces_are_rings_without_bad_triangles(sampled, name):
 
 @pytest.mark.parametrize(
     "name",
-    ["square_ring", "cone", "block_two_holes", "cone_tip", "conebox", "wedge", "star_prism"],
+    [
+        "square_ring",
+        "cone",
+        "block_two_holes",
+        "cone_tip",
+        "conebox",
+        "wedge",
+        "star_prism",
+        "cutcube",
+    ],
 )
 def test_shapes_meet_condition_iii(checked, name):
     """No sample breaks Condition III by the geodesic check: every sample in
@@ -471,7 +480,10 @@ def test_shapes_meet_condition_iii(checked, name):
     sides' columns follow (worst 0.828; 1.20% violating with them fixed);
     star_prism: the same, and the angle its caps' repair left at a reflex
     corner split by a sample on its bisector (worst 0.838; 0.12% violating
-    without the split, 2.93% with its edge samples fixed)."""
+    without the split, 2.93% with its edge samples fixed); cutcube: its
+    scoop's rows h apart along the sphere and the scoop repaired on its
+    stereographic map, framed by the cube's faces across its rims (worst
+    0.853; 0.60% violating with the scan rows)."""
     rep = checked(name)
     assert rep.max_degree <= 33
     assert np.all(rep.worst_ratio < np.sqrt(3) / 2)
@@ -610,3 +622,17 @@ def test_apex_fans_meet_condition_iii_with_their_spokes_delaunay():
     fan = _apex_fan(math.radians(126.0))
     np.testing.assert_allclose(fan.radii, [1.0, 1.0, 0.76])
     np.testing.assert_allclose(fan.at * 126.0, [0.0, 82.0, 104.0])
+
+
+def test_partial_spheres_with_sharp_rims_are_repaired(sampled):
+    """cutcube's scoop (three sharp circular rims) is repaired on its
+    stereographic map and left with no triangle above the repair's margin;
+    fillet_box's corners blend into its fillets (no sampled rim) and keep
+    their scan rows."""
+    _, r = sampled["cutcube"]
+    spheres = [x for x in r.meta["repairs"] if x["kind"] == "sphere"]
+    assert len(spheres) == 1
+    assert spheres[0]["bad"] == 0 and spheres[0]["worst"] < np.sqrt(3) / 2
+    assert spheres[0]["added"] + spheres[0]["removed"] > 0
+    _, r = sampled["fillet_box"]
+    assert not [x for x in r.meta["repairs"] if x["kind"] == "sphere"]

@@ -1,0 +1,239 @@
+"""Partial spheres with sharp rims, repaired on their stereographic map.
+
+A partial sphere (cutcube's scoop) keeps its scan rows: sections by the
+family's planes, their columns at multiples of one angle that doubles where
+a row's gaps would fall below 0.75 h (:func:`samplers.scanline._sphere_row`).
+Where the columns halve, and where the rows end on the sphere's sharp rims
+at arbitrary places, Delaunay triangles break Condition III-ii.
+:func:`repair_sphere_faces` maps each such face onto the plane by the
+stereographic projection from the point opposite the face's centre.  The
+map is conformal, so a triangle's ratio of Condition III-ii is kept up to
+the change of scale across it (at most 10% over the whole face when the
+face lies within 37° of its centre), and it maps circles to circles: the
+rims stay circular arcs, along which :func:`samplers.layers._clamp` keeps
+the free samples on the face.  There the face is repaired like a planar
+one (:func:`samplers.repair.repair`): the rims' samples fixed, every other
+sample of the face free.
+
+CadQuery and OCP are imported when the functions run.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .layers import (
+    RASTER,
+    Samples,
+    _Arc,
+    _arc_sides,
+    _boundary_segments,
+    _clamp,
+    _goes_round,
+    _perpendicular,
+    _Raster,
+    _segment_distance,
+)
+from .repair import repair, split_corners
+from .scanline import rims_sampled
+
+FRAME_REACH = 2.5  # the neighbours' samples this near a rim (times h) frame the repair
+FACING = 0.2  # the face lies where the direction from the centre has cos > this with the pole
+
+
+class _Stereographic:
+    """The stereographic projection of a sphere from the point opposite
+    ``pole`` (a unit vector from the centre), scaled to be isometric at the
+    pole: a point at angle θ from it maps to ``2 R tan(θ / 2)``."""
+
+    def __init__(self, centre: np.ndarray, radius: float, pole: np.ndarray):
+        self.centre, self.radius, self.pole = centre, radius, pole
+        self.e1 = _perpendicular(pole)
+        self.e2 = np.cross(pole, self.e1)
+
+    def __call__(self, p) -> np.ndarray:
+        u = (np.asarray(p, dtype=np.float64) - self.centre) / self.radius
+        den = 1.0 + u @ self.pole
+        return 2.0 * self.radius * np.stack([u @ self.e1, u @ self.e2], axis=1) / den[:, None]
+
+    def inverse(self, q: np.ndarray) -> np.ndarray:
+        x = q / (2.0 * self.radius)
+        s2 = (x**2).sum(axis=1)
+        u = (
+            2.0 * x[:, :1] * self.e1 + 2.0 * x[:, 1:] * self.e2 + (1.0 - s2)[:, None] * self.pole
+        ) / (1.0 + s2)[:, None]
+        return self.centre + self.radius * u
+
+
+def _circle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """Centre and radius of the circle through three 2-D points (None when
+    they are collinear)."""
+    d = 2.0 * (a[0] * (b[1] - c[1]) + b[0] * (c[1] - a[1]) + c[0] * (a[1] - b[1]))
+    scale = max(np.ptp(np.stack([a, b, c]), axis=0).max(), 1e-300)
+    if abs(d) < 1e-9 * scale**2:
+        return None
+    sa, sb, sc = a @ a, b @ b, c @ c
+    ux = (sa * (b[1] - c[1]) + sb * (c[1] - a[1]) + sc * (a[1] - b[1])) / d
+    uy = (sa * (c[0] - b[0]) + sb * (a[0] - c[0]) + sc * (b[0] - a[0])) / d
+    centre = np.array([ux, uy])
+    return centre, float(np.linalg.norm(a - centre))
+
+
+def _rim_arcs(face, to2d) -> list[_Arc] | None:
+    """The face's rims as arcs of the map (None when one is not a circle
+    there: a rim through the projection's point, or an edge that is no
+    circle)."""
+    out = []
+    for e in face.Edges():
+        if e.geomType() != "CIRCLE":
+            return None
+        if e.IsClosed():
+            pts = to2d(np.array([e.positionAt(x).toTuple() for x in (0.0, 1 / 3, 2 / 3)]))
+            fit = _circle(*pts)
+            if fit is None:
+                return None
+            out.append(_Arc(fit[0], fit[1], 0.0, 2 * math.pi, True, False))
+            continue
+        s, m, f = to2d(np.array([e.positionAt(x).toTuple() for x in (0.0, 0.5, 1.0)]))
+        fit = _circle(s, m, f)
+        if fit is None:
+            return None
+        c, r = fit
+        a0, am, a1 = (math.atan2(*(q - c)[::-1]) for q in (s, m, f))
+        span = (a1 - a0) % (2 * math.pi)
+        if (am - a0) % (2 * math.pi) > span:  # the arc runs the other way round
+            a0, span = a1, 2 * math.pi - span
+        out.append(_Arc(c, r, a0, span, False, False))
+    return out
+
+
+def _rim_frame(face, arcs, sides, to2d: _Stereographic, s: Samples, own, h: float):
+    """The samples of the faces across the rims, within ``FRAME_REACH`` h of
+    a rim, unfolded into the map: each at its distance from the rim (times
+    the map's scale there), straight out from its nearest rim point.  Their
+    triangles with the face's samples cross the sharp rim; judged with the
+    face's own (``judge_frame``), they keep the samples on either side from
+    crowding the rim together (cutcube: a triangle of 0.59 h, 0.69 h and
+    0.77 h across the scoop's rim, ratio 0.89)."""
+    others = np.flatnonzero(~own & ~s.on_feature)
+    out = []
+    for e, a, side in zip(face.Edges(), arcs, sides):
+        circ = e._geomAdaptor().Circle()
+        cc = np.array(circ.Location().Coord())
+        nn = np.array(circ.Axis().Direction().Coord())
+        rr = float(circ.Radius())
+        x = s.points[others]
+        w = x - cc
+        w -= np.outer(w @ nn, nn)
+        norm = np.linalg.norm(w, axis=1)
+        ok = norm > 1e-12 * rr
+        y = cc + rr * w[ok] / norm[ok, None]  # the nearest point of the rim's circle
+        d = np.linalg.norm(x[ok] - y, axis=1)
+        near = d < FRAME_REACH * h
+        if not near.any():
+            continue
+        y, d = y[near], d[near]
+        yy = to2d(y)
+        # only where the rim (an arc of its circle) is nearest
+        ang = (np.arctan2(*(yy - a.centre).T[::-1]) - a.start) % (2 * math.pi)
+        on_arc = a.closed | (ang <= a.span)
+        yy, d = yy[on_arc], d[on_arc]
+        out_dir = side * (yy - a.centre)
+        out_dir /= np.linalg.norm(out_dir, axis=1)[:, None]
+        scale = 1.0 + (yy**2).sum(axis=1) / (2.0 * to2d.radius) ** 2
+        out.append(yy + (d * scale)[:, None] * out_dir)
+    return np.vstack(out) if out else np.empty((0, 2))
+
+
+def repair_sphere_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
+    """Repair every partial sphere whose rims are all sampled (sharp edges).
+
+    Parameters
+    ----------
+    occ : cadquery.Shape
+        The shape sampled.
+    s : Samples
+        Its samples, edited in place: the face's samples off its rims are
+        replaced by the repair's.
+    h : float
+        The sample spacing.
+    size : float
+        The shape's bounding-box diagonal (tolerances).
+
+    Returns
+    -------
+    list of dict
+        One report per repaired face (kind ``"sphere"``: samples, added,
+        removed, bad, worst).
+
+    Notes
+    -----
+    A face whose rims are not all sharp (fillet_box's corners, blending
+    smoothly into cylinders whose rows cross the seams) is left as scanned:
+    its samples near a seam are bound to the neighbour's rows, which this
+    map does not hold.
+    """
+    reports = []
+    tol = 1e-7 * size
+    feature = s.points[s.on_feature]
+    for fi, face in enumerate(occ.Faces()):
+        if face.geomType() != "SPHERE" or _goes_round(face):
+            continue
+        sph = face._geomAdaptor().Sphere()
+        centre = np.array(sph.Location().Coord())
+        radius = float(sph.Radius())
+        if not rims_sampled(face, feature, h):
+            continue
+        pole = np.array(face.Center().toTuple()) - centre
+        if np.linalg.norm(pole) < 1e-9 * radius:
+            continue
+        pole /= np.linalg.norm(pole)
+        to2d = _Stereographic(centre, radius, pole)
+        arcs = _rim_arcs(face, to2d)
+        if arcs is None:
+            continue
+        q = s.points - centre
+        dist = np.linalg.norm(q, axis=1)
+        cand = np.flatnonzero((np.abs(dist - radius) < tol) & (q @ pole > FACING * radius))
+        uv = to2d(s.points[cand])
+        seg = _boundary_segments(face, to2d, h / 20)
+        raster = _Raster(seg, h / RASTER)
+        mine = raster(uv) | (_segment_distance(uv, seg, h / 100) < 0.1 * h)
+        idx, uv = cand[mine], uv[mine]
+        order = np.lexsort((np.round(uv[:, 1] / h, 6), np.round(uv[:, 0] / h, 6)))
+        idx, uv = idx[order], uv[order]
+        free = ~s.on_feature[idx]
+        if not free.any():
+            continue
+        sides = _arc_sides(arcs, raster, h)
+        own = np.zeros(s.points.shape[0], dtype=bool)
+        own[idx] = True
+        frame = _rim_frame(face, arcs, sides, to2d, s, own, h)
+        args = dict(inside=raster, clamp=_clamp(arcs, sides, h), frame=frame, judge_frame=True)
+        r = repair(uv, free, h, **args)
+        if r.worst >= math.sqrt(3) / 2:
+            r = split_corners(uv, free, h, r, **args)
+        src = np.where(r.origin >= 0, idx[np.maximum(r.origin, 0)], -1)
+        moved = src >= 0
+        s.replace(
+            idx,
+            to2d.inverse(r.uv),
+            np.where(moved, s.line_id[np.maximum(src, 0)], -3),
+            np.where(moved, s.face_id[np.maximum(src, 0)], fi),
+            np.where(moved, s.on_feature[np.maximum(src, 0)], False),
+        )
+        feature = s.points[s.on_feature]
+        reports.append(
+            {
+                "face": fi,
+                "kind": "sphere",
+                "samples": int(idx.size),
+                "added": int((~moved).sum()),
+                "removed": int(idx.size - moved.sum()),
+                "bad": r.bad,
+                "worst": r.worst,
+            }
+        )
+    return reports
