@@ -69,6 +69,7 @@ def test_sampling_logs_every_step_at_debug_level(caplog):
     steps = re.findall(r"sample: ([a-z ]+) took \d+\.\d+ s", caplog.text)
     first = ["feature samples", "scan rows", "gaps filled"]
     repairs = ["disks", "planar faces", "cylinders", "cones", "bodies of revolution"]
+    repairs += ["partial spheres"]
     assert steps == first + repairs + first
 
 
