@@ -62,6 +62,31 @@ class Samples:
         self.face_id = np.r_[self.face_id[keep], face_id].astype(np.int64)
         self.on_feature = np.r_[self.on_feature[keep], on_feature].astype(bool)
 
+    def put(self, idx: np.ndarray, r: Repaired, points: np.ndarray, face: int, kind: str) -> dict:
+        """Replace the samples ``idx`` by the answer ``r`` of their repair
+        (its samples at ``points``, in 3-D): a sample it kept keeps its
+        line, face and feature flag; one it added is on line -3, on
+        ``face``, off the features.  Returns the face's report."""
+        src = np.where(r.origin >= 0, idx[np.maximum(r.origin, 0)], -1)
+        moved = src >= 0
+        was = np.maximum(src, 0)
+        self.replace(
+            idx,
+            points,
+            np.where(moved, self.line_id[was], -3),
+            np.where(moved, self.face_id[was], face),
+            np.where(moved, self.on_feature[was], False),
+        )
+        return {
+            "face": face,
+            "kind": kind,
+            "samples": int(idx.size),
+            "added": int((~moved).sum()),
+            "removed": int(idx.size - moved.sum()),
+            "bad": r.bad,
+            "worst": r.worst,
+        }
+
 
 class _Raster:
     """Inside test of a 2-D domain given by its boundary segments (even-odd rule)."""
@@ -480,10 +505,9 @@ def repair_planar_faces(
     0.879 -> 0.853).  A repair still at or above √3/2 with at most
     ``FEW_BAD`` triangles above its margin gets the angles at its fixed
     samples split (:func:`samplers.repair.split_corners`; star prism's
-    reflex corners: 0.938 -> 0.838, none of its samples violating III-ii
-    any more; cutcube 0.77% -> 0.60% violating, fillet_box 2.22% -> 2.10%;
-    the pyramid's faces, with over 50 each, are left as they are: each
-    split runs the repair again).  Faces bounded by straight edges only,
+    reflex corners: 0.938 -> 0.850, none of its samples violating III-ii
+    any more; the pyramid's faces, with over 50 each, are left as they
+    are: each split runs the repair again).  Faces bounded by straight edges only,
     with the same edges and edge samples, get one answer even where a gap
     was filled on one of them only (a prism's two ends; their sides'
     columns run straight from one to the other).  Returns one report per
@@ -638,28 +662,11 @@ def repair_planar_faces(
             shifts.setdefault(ln.other, []).append(
                 (a3, u3, np.r_[0.0, s0[order], length], np.r_[0.0, (s1 - s0)[order], 0.0])
             )
-        s.replace(
-            idx,
-            pts3,
-            np.where(moved, s.line_id[np.maximum(src, 0)], -3),
-            np.where(moved, s.face_id[np.maximum(src, 0)], fi),
-            np.where(moved, s.on_feature[np.maximum(src, 0)], False),
-        )
         rim = moved & s.on_feature[np.maximum(src, 0)]
+        reports.append(s.put(idx, r, pts3, fi, "plane"))
         for a in arcs:
             if a.wall >= 0 and a.wall not in walls:
                 walls[a.wall] = pts3[rim & (a.distance(r.uv) < tol)]
-        reports.append(
-            {
-                "face": fi,
-                "kind": "plane",
-                "samples": int(idx.size),
-                "added": int((~moved).sum()),
-                "removed": int(idx.size - moved.sum()),
-                "bad": r.bad,
-                "worst": r.worst,
-            }
-        )
     _follow_columns(s, shifts, faces, tol)
     return reports
 

@@ -24,7 +24,10 @@ import math
 
 import numpy as np
 
+from validators.conditions import SQRT3_2
+
 from .layers import (
+    FEW_BAD,
     RASTER,
     Samples,
     _Arc,
@@ -213,27 +216,8 @@ def repair_sphere_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         frame = _rim_frame(face, arcs, sides, to2d, s, own, h)
         args = dict(inside=raster, clamp=_clamp(arcs, sides, h), frame=frame, judge_frame=True)
         r = repair(uv, free, h, **args)
-        if r.worst >= math.sqrt(3) / 2:
+        if r.worst >= SQRT3_2 and r.bad <= FEW_BAD:
             r = split_corners(uv, free, h, r, **args)
-        src = np.where(r.origin >= 0, idx[np.maximum(r.origin, 0)], -1)
-        moved = src >= 0
-        s.replace(
-            idx,
-            to2d.inverse(r.uv),
-            np.where(moved, s.line_id[np.maximum(src, 0)], -3),
-            np.where(moved, s.face_id[np.maximum(src, 0)], fi),
-            np.where(moved, s.on_feature[np.maximum(src, 0)], False),
-        )
+        reports.append(s.put(idx, r, to2d.inverse(r.uv), fi, "sphere"))
         feature = s.points[s.on_feature]
-        reports.append(
-            {
-                "face": fi,
-                "kind": "sphere",
-                "samples": int(idx.size),
-                "added": int((~moved).sum()),
-                "removed": int(idx.size - moved.sum()),
-                "bad": r.bad,
-                "worst": r.worst,
-            }
-        )
     return reports
