@@ -507,9 +507,9 @@ def repair_planar_faces(
     samples split (:func:`samplers.repair.split_corners`; star prism's
     reflex corners: 0.938 -> 0.850, none of its samples violating III-ii
     any more; the pyramid's faces, with over 50 each, are left as they
-    are: each split runs the repair again).  Faces bounded by straight edges only,
-    with the same edges and edge samples, get one answer even where a gap
-    was filled on one of them only (a prism's two ends; their sides'
+    are: each split runs a repair again).  Faces bounded by straight edges
+    only, with the same edges and edge samples, get one answer even where
+    a gap was filled on one of them only (a prism's two ends; their sides'
     columns run straight from one to the other).  Returns one report per
     repaired face.
     """

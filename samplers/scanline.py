@@ -448,8 +448,8 @@ def _plane_offsets(lo: float, hi: float, t0: float, hf: float, sphere=None) -> n
     and where the columns halve such rows made near-equilateral triangles
     (cutcube's scoop: 13 at a ratio of 0.99 to 1.0).  A sphere blending
     into its neighbours (fillet_box's corners) keeps the family's planes,
-    whose rows go on across the seams (its meridian rows: 2.10% -> 3.80% of
-    the samples violating III-ii)."""
+    whose rows go on across the seams (with meridian rows 3.8% of its
+    samples violated III-ii instead of 2.1%)."""
     if sphere is None:
         j0 = math.ceil((lo - t0) / hf - 1e-9)
         j1 = math.floor((hi - t0) / hf + 1e-9)
