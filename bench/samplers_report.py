@@ -66,7 +66,7 @@ def main(argv=None) -> int:
     rows = {}
     head = (
         f"{'shape':<16}{'points':>7}{'h':>7}{'nn min/med/max (h)':>20}{'close':>7}"
-        f"{'cover':>7}{'on CAD':>9}{'III':>7}{'viol':>6}{'deg':>5}{'build':>7}{'scan':>6}"
+        f"{'cover':>7}{'on CAD':>9}{'III':>7}{'viol':>6}{'deg':>5}{'build':>7}{'scan':>7}"
         f" | {'expect':>10} | {'open':>5}{'over':>5}{'euler':>6}  ok"
     )
     print(head)
@@ -132,7 +132,7 @@ def main(argv=None) -> int:
             f"{name:<16}{len(p):>7}{h:>7.3f}{nn.min():>8.2f}/{np.median(nn):.2f}/{nn.max():.2f}"
             f"{nn.min():>7.2f}{cover:>7.2f}{on:>9.1e}{cond.max_ratio:>7.3f}"
             f"{100 * violating / len(p):>5.1f}%{cond.max_degree:>5}"
-            f"{tb:>7.2f}{ts:>6.2f} | χ{e.euler:>3} b{e.boundary_loops} g{e.genus} |"
+            f"{tb:>7.2f}{ts:>7.2f} | χ{e.euler:>3} b{e.boundary_loops} g{e.genus} |"
             f" {st.open_edges:>5}{st.overloaded_edges:>5}{st.euler:>6}  {'yes' if match else 'NO'}"
         )
         rows[name]["topology_matches"] = bool(match)
