@@ -141,6 +141,15 @@ class _Arc:
     slides: bool  # its samples slide along it (it bounds a full cylinder)
     wall: int = -1  # the index of that full cylinder's face, else -1
 
+    @classmethod
+    def through(cls, centre, radius: float, s, m, f, slides: bool = False, wall: int = -1):
+        """The open arc of that circle from ``s`` through ``m`` to ``f`` (2-D points)."""
+        a0, am, a1 = (math.atan2(*(np.asarray(q) - centre)[::-1]) for q in (s, m, f))
+        span = (a1 - a0) % (2 * math.pi)
+        if (am - a0) % (2 * math.pi) > span:  # the arc runs the other way round
+            a0, span = a1, 2 * math.pi - span
+        return cls(centre, radius, a0, span, False, slides, wall)
+
     def distance(self, p: np.ndarray) -> np.ndarray:
         return np.abs(np.linalg.norm(p - self.centre, axis=1) - self.radius)
 
@@ -178,12 +187,8 @@ def _arcs(face, to2d, across=()) -> list[_Arc]:
         if e.IsClosed():
             out.append(_Arc(c, r, 0.0, 2 * math.pi, True, slides, wall))
             continue
-        s, m, f = (to2d(np.array([e.positionAt(x).toTuple()]))[0] - c for x in (0.0, 0.5, 1.0))
-        a0, am, a1 = (math.atan2(q[1], q[0]) for q in (s, m, f))
-        span = (a1 - a0) % (2 * math.pi)
-        if (am - a0) % (2 * math.pi) > span:  # the arc runs the other way round
-            a0, span = a1, 2 * math.pi - span
-        out.append(_Arc(c, r, a0, span, False, slides, wall))
+        s, m, f = (to2d(np.array([e.positionAt(x).toTuple()]))[0] for x in (0.0, 0.5, 1.0))
+        out.append(_Arc.through(c, r, s, m, f, slides, wall))
     return out
 
 

@@ -717,7 +717,7 @@ def split_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
         if out.worst < SQRT3_2:
             break
         was = np.where(out.origin >= 0, out.origin, n)  # n: a sample some repair added
-        fixed = ~np.r_[free | slide, True][was]
+        fixed = ~_flags(free | slide, was, True)
         corner = _corner_wedge(out, fixed, inside)
         if corner is None:
             break
@@ -734,10 +734,11 @@ def split_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
             src = np.r_[of, n][np.where(trial.origin >= 0, trial.origin, of.size)]
             judged = repair(trial.uv, _flags(free, src, True), h, **_roles(src), **fixed_kw)
             if best is None or (judged.worst, judged.bad) < (best[0].worst, best[0].bad):
-                best = (judged, trial, out.uv.shape[0])
+                best = (judged, trial)
         if best is None or best[0].worst >= out.worst:
             break
-        judged, trial, m = best
-        origin = np.r_[out.origin, -1][np.where(trial.origin >= 0, trial.origin, m)]
+        judged, trial = best
+        added = out.uv.shape[0]  # the index of the sample this round added
+        origin = np.r_[out.origin, -1][np.where(trial.origin >= 0, trial.origin, added)]
         out = Repaired(uv=trial.uv, origin=origin, bad=judged.bad, worst=judged.worst)
     return out

@@ -103,12 +103,7 @@ def _rim_arcs(face, to2d) -> list[_Arc] | None:
         fit = _circle(s, m, f)
         if fit is None:
             return None
-        c, r = fit
-        a0, am, a1 = (math.atan2(*(q - c)[::-1]) for q in (s, m, f))
-        span = (a1 - a0) % (2 * math.pi)
-        if (am - a0) % (2 * math.pi) > span:  # the arc runs the other way round
-            a0, span = a1, 2 * math.pi - span
-        out.append(_Arc(c, r, a0, span, False, False))
+        out.append(_Arc.through(*fit, s, m, f))
     return out
 
 
@@ -226,5 +221,4 @@ def repair_sphere_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         if r.worst >= SQRT3_2 and r.bad <= FEW_BAD:
             r = split_corners(uv, free, h, r, **args)
         reports.append(s.put(idx, r, to2d.inverse(r.uv), fi, "sphere"))
-        feature = s.points[s.on_feature]
     return reports
