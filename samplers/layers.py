@@ -511,12 +511,12 @@ def repair_planar_faces(
     ``FEW_BAD`` triangles above its margin gets the angles at its fixed
     samples split (:func:`samplers.repair.split_corners`; star prism's
     reflex corners: 0.938 -> 0.850, none of its samples violating III-ii
-    any more; the pyramid's faces, with over 50 each, are left as they
-    are: each split runs a repair again).  Faces bounded by straight edges
-    only, with the same edges and edge samples, get one answer even where
-    a gap was filled on one of them only (a prism's two ends; their sides'
-    columns run straight from one to the other).  Returns one report per
-    repaired face.
+    any more; a pyramid 0.8 high on its unit base, with over 50 on each
+    face, is left as it is: each split runs a repair again).  Faces
+    bounded by straight edges only, with the same edges and edge samples,
+    get one answer even where a gap was filled on one of them only (a
+    prism's two ends; their sides' columns run straight from one to the
+    other).  Returns one report per repaired face.
     """
     reports = []
     done: dict[tuple, object] = {}

@@ -30,6 +30,9 @@ a CadQuery shape:
 * where the rows leave a gap (planes grazing a face: the poles of a sphere),
   extra samples are projected onto the surface until every point of it is
   within h of a sample (their ``line_id`` is -2);
+* a right square pyramid no taller than about 0.57 of its base is laid
+  out as one lattice, its lateral rows on the base's columns and its
+  lateral edges the cells' diagonals (:mod:`samplers.pyramids`);
 * planar disks and annuli whose rims bound cones or cylinders are laid
   out in rings about their centre, halving their columns inwards
   (:mod:`samplers.disks`);
@@ -761,7 +764,7 @@ def scan(
     faces = occ.Faces()
     if not faces:
         raise SamplingError("shape has no faces to sample")
-    with bar(len(faces) + 2 + (6 if repair else 0), "sample", quiet, unit="step") as pbar:
+    with bar(len(faces) + 2 + (7 if repair else 0), "sample", quiet, unit="step") as pbar:
         lo, hi = _exact_bounds(occ)
         size = float(np.linalg.norm(hi - lo))
         area = float(sum(f.Area() for f in faces))
@@ -854,15 +857,20 @@ def scan(
                 lattice_revolved_body,
                 repair_planar_faces,
             )
+            from .pyramids import lattice_pyramid
             from .spheres import repair_sphere_faces
 
             bag = Samples(points, line_id, face_id, on_feature)
+            with timed("sample: pyramids"):
+                reports, laid = lattice_pyramid(occ, bag, h, size)
+            pbar.update(1)
             with timed("sample: disks"):
-                reports, rings = lattice_disk_faces(occ, bag, h, size)
+                more, rings = lattice_disk_faces(occ, bag, h, size)
+                reports += more
             pbar.update(1)
             with timed("sample: planar faces"):
                 reports += repair_planar_faces(
-                    occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=rings
+                    occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=rings | laid
                 )
             pbar.update(1)
             for step, lay in (

@@ -520,7 +520,7 @@ _SPECS: dict[str, _Spec] = {
     ),
     "pyramid": _Spec(
         "square pyramid: an apex where 4 sharp edges meet",
-        {"base": 1.0, "height": 0.8},
+        {"base": 1.0, "height": 0.5},
         _check_pyramid,
         _make_pyramid,
     ),

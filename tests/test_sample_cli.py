@@ -68,8 +68,8 @@ def test_sampling_logs_every_step_at_debug_level(caplog):
         scan(shapes.build("cube"), 0.1, repair=False)
     steps = re.findall(r"sample: ([a-z ]+) took \d+\.\d+ s", caplog.text)
     first = ["feature samples", "scan rows", "gaps filled"]
-    repairs = ["disks", "planar faces", "cylinders", "cones", "bodies of revolution"]
-    repairs += ["partial spheres"]
+    repairs = ["pyramids", "disks", "planar faces", "cylinders", "cones"]
+    repairs += ["bodies of revolution", "partial spheres"]
     assert steps == first + repairs + first
 
 

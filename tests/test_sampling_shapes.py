@@ -25,6 +25,15 @@ def sampled():
 
 
 @pytest.fixture(scope="module")
+def tall_pyramid():
+    """A pyramid of height 0.8 on its unit base (lateral cells of ratio
+    sin(beta) = 0.88 as one lattice): it keeps the scan rows and their
+    repair, the path of any face with edges slanted to its rows."""
+    s = shapes.build("pyramid", height=0.8)
+    return s, scan(s)
+
+
+@pytest.fixture(scope="module")
 def checked(sampled):
     """The geodesic sample-condition check of a shape's default samples, run once."""
     pytest.importorskip("potpourri3d")
@@ -193,13 +202,13 @@ def lateral_edge_samples(solid, r):
         yield e, t, on & (t > 1e-9) & (t < length - 1e-9), length
 
 
-def test_slanted_edges_hold_the_ends_of_their_faces_lattice_lines(sampled):
-    """A pyramid's lateral edges run slanted to the rows of both faces they
+def test_slanted_edges_hold_the_ends_of_their_faces_lattice_lines(tall_pyramid):
+    """A tall pyramid's lateral edges run slanted to the rows of both faces they
     bound: they are sampled where one face's lattice lines (its rows, or the
     columns along them) cross them, at most 1.45 h apart, so that those
     lines end on edge samples (before the layer repair, which slides them);
     an end gap wider than 1.5 h is split."""
-    s = sampled["pyramid"][0]
+    s = tall_pyramid[0]
     r = scan(s, repair=False)
     p, h = r.points, r.meta["spacing"]
     dirs = np.asarray(r.meta["directions"])
@@ -238,14 +247,15 @@ def test_slanted_edges_hold_the_ends_of_their_faces_lattice_lines(sampled):
     assert slanted == 4
 
 
-def test_edges_slanted_to_both_faces_rows_slide_along_them(sampled):
+def test_edges_slanted_to_both_faces_rows_slide_along_them(tall_pyramid):
     """The layer repair slides the samples of an edge slanted to both its
-    faces' rows (a pyramid's lateral edges) and judges the triangles across
+    faces' rows (a tall pyramid's lateral edges) and judges the triangles across
     it: they move along the edge, off the crossings' lattice, and keep
     between h / 2 and 1.6 h from each other and from the corners (the
     repair's soft bounds are 0.75 h and 1.35 h; 0.57 h to 1.55 h measured)."""
-    s, r = sampled["pyramid"]
+    s, r = tall_pyramid
     h = r.meta["spacing"]
+    assert not [x for x in r.meta["repairs"] if x["kind"] == "pyramid lattice"]
     lateral = 0
     for _, t, on, length in lateral_edge_samples(s.solid, r):
         lateral += 1
@@ -456,6 +466,7 @@ def test_round_faces_are_rings_without_bad_triangles(sampled, name):
     "name",
     [
         "square_ring",
+        "pyramid",
         "cone",
         "block_two_holes",
         "cone_tip",
@@ -470,7 +481,10 @@ def test_shapes_meet_condition_iii(checked, name):
     a DT_M triangle (none left out, as a cone's apex was when its cell's
     corners fell between the truth's vertices) and every ratio below √3/2.
     square_ring: annuli in rings, walls as the lattice of their rims (worst
-    0.805); cone: a designed fan of two spokes round the apex (worst 0.859);
+    0.805); pyramid: one lattice, the ties across its lateral edges
+    decided (worst 0.830; 0.866 with the ties left, 2.09% violating with
+    the scan rows at height 0.8); cone: a designed fan of two spokes
+    round the apex (worst 0.859);
     block_two_holes: its one near tie decided by the angle test (worst
     0.847, 0.870 by the labels alone); cone_tip: an uneven fan of three
     spokes round its apex (worst 0.863); conebox: its cone's stuck ring
