@@ -32,19 +32,24 @@ a CadQuery shape:
   within h of a sample (their ``line_id`` is -2);
 * a right square pyramid no taller than about 0.57 of its base is laid
   out as one lattice, its lateral rows on the base's columns and its
-  lateral edges the cells' diagonals (:mod:`samplers.pyramids`);
+  lateral edges the cells' diagonals (:mod:`samplers.pyramids`); a box
+  with filleted vertical and top edges as lattices continued across the
+  fillets' seams, its corner octants in latitude rows repaired on their
+  stereographic map (:mod:`samplers.fillets`);
 * planar disks and annuli whose rims bound cones or cylinders are laid
   out in rings about their centre, halving their columns inwards
   (:mod:`samplers.disks`);
 * where rows meet a circular sharp edge (a hole, the cut of a scoop) the
   boundary layer of each other planar face is repaired until its
   Delaunay triangles meet Condition III-ii (:mod:`samplers.layers`,
-  :mod:`samplers.repair`); full cylinders are then laid out as the lattice
-  their two rims span, and cones with a sampled rim in rings that keep the
-  rim's columns and end crowded ones towards the apex; a partial sphere
-  whose rims are all sharp (cutcube's scoop) takes rows h apart along its
-  meridians and is repaired on its stereographic map (:mod:`samplers.spheres`)
-  (``repair=False`` keeps the plain scan rows);
+  :mod:`samplers.repair`; a face left with a few triangles at or above
+  √3/2 is repaired once more from that answer); full cylinders are then
+  laid out as the lattice their two rims span, and cones with a sampled
+  rim in rings that keep the rim's columns and end crowded ones towards
+  the apex; a partial sphere whose rims are all sharp (cutcube's scoop)
+  takes rows h apart along its meridians and is repaired on its
+  stereographic map (:mod:`samplers.spheres`) (``repair=False`` keeps the
+  plain scan rows);
 * optional Gaussian jitter (σ·h) and dropout, both seeded.
 
 Every sample before jitter lies on the CAD surface (points are evaluated on
@@ -63,6 +68,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from sr33._progress import bar, log, timed
+from validators.conditions import SQRT3_2
 
 from .adjacency import EdgeFaces
 
@@ -764,7 +770,7 @@ def scan(
     faces = occ.Faces()
     if not faces:
         raise SamplingError("shape has no faces to sample")
-    with bar(len(faces) + 2 + (7 if repair else 0), "sample", quiet, unit="step") as pbar:
+    with bar(len(faces) + 2 + (8 if repair else 0), "sample", quiet, unit="step") as pbar:
         lo, hi = _exact_bounds(occ)
         size = float(np.linalg.norm(hi - lo))
         area = float(sum(f.Area() for f in faces))
@@ -850,7 +856,9 @@ def scan(
         reports: list[dict] = []
         if repair:
             from .disks import lattice_disk_faces
+            from .fillets import lattice_filleted_box
             from .layers import (
+                FEW_BAD,
                 Samples,
                 lattice_cone_faces,
                 lattice_cylinder_faces,
@@ -864,14 +872,29 @@ def scan(
             with timed("sample: pyramids"):
                 reports, laid = lattice_pyramid(occ, bag, h, size)
             pbar.update(1)
+            with timed("sample: filleted boxes"):
+                more, boxed = lattice_filleted_box(occ, bag, h, size)
+                reports += more
+                laid |= boxed
+            pbar.update(1)
             with timed("sample: disks"):
                 more, rings = lattice_disk_faces(occ, bag, h, size)
                 reports += more
             pbar.update(1)
             with timed("sample: planar faces"):
-                reports += repair_planar_faces(
-                    occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=rings | laid
-                )
+                rows = [dirs[f] for f in fam]
+                planar = repair_planar_faces(occ, bag, h, size, row_dirs=rows, skip=rings | laid)
+                # a face stuck with a few triangles at or above √3/2 is
+                # repaired once more from its answer (fillet_box's bottom:
+                # two of 0.884 where its corners' arcs meet the rows -> none)
+                stuck = {x["face"] for x in planar if x["worst"] >= SQRT3_2 and x["bad"] <= FEW_BAD}
+                if stuck:
+                    again = repair_planar_faces(
+                        occ, bag, h, size, row_dirs=rows, skip=set(range(len(faces))) - stuck
+                    )
+                    redone = {x["face"]: x for x in again}
+                    planar = [redone.get(x["face"], x) for x in planar]
+                reports += planar
             pbar.update(1)
             for step, lay in (
                 ("cylinders", lattice_cylinder_faces),

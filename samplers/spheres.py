@@ -169,56 +169,72 @@ def repair_sphere_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     Notes
     -----
     A face whose rims are not all sharp (fillet_box's corners, blending
-    smoothly into cylinders whose rows cross the seams) is left as scanned:
-    repaired the same way, the seams' samples fixed and the fillets' as the
-    frame, fillet_box went from 2.1% to 0.4% of its samples violating III-ii
-    (the rest across the seams) but its default sampling from 10 s to 60 s.
-    So is a face reaching more than about 78° (``FACING``) from its centre,
-    where the map would stretch too much.
+    smoothly into cylinders) is left here: repaired this way amid the scan
+    rows, the seams' samples fixed and the fillets' as the frame,
+    fillet_box went from 2.1% to 0.4% of its samples violating III-ii (the
+    rest across the seams); laid out with the rest of its box, whose
+    lattices meet the seams square, it is repaired by
+    :func:`samplers.fillets.lattice_filleted_box`.  So is a face reaching
+    more than about 78° (``FACING``) from its centre, where the map would
+    stretch too much.
     """
     reports = []
-    tol = 1e-7 * size
     feature = s.points[s.on_feature]
     for fi, face in enumerate(occ.Faces()):
         if face.geomType() != "SPHERE" or _goes_round(face):
             continue
         if not rims_sampled(face, feature, h):
             continue
-        sph = face._geomAdaptor().Sphere()
-        centre = np.array(sph.Location().Coord())
-        radius = float(sph.Radius())
-        pole = np.array(face.Center().toTuple()) - centre
-        if np.linalg.norm(pole) < 1e-9 * radius:
-            continue
-        pole /= np.linalg.norm(pole)
-        verts, _ = face.tessellate(h / 20, 0.3)
-        reach = (np.array([v.toTuple() for v in verts]) - centre) @ pole
-        if reach.min() <= FACING * radius:
-            continue  # the face wraps too far round for one map
-        to2d = _Stereographic(centre, radius, pole)
-        arcs = _rim_arcs(face, to2d)
-        if arcs is None:
-            continue
-        q = s.points - centre
-        dist = np.linalg.norm(q, axis=1)
-        cand = np.flatnonzero((np.abs(dist - radius) < tol) & (q @ pole > FACING * radius))
-        uv = to2d(s.points[cand])
-        seg = _boundary_segments(face, to2d, h / 20)
-        raster = _Raster(seg, h / RASTER)
-        mine = raster(uv) | (_segment_distance(uv, seg, h / 100) < 0.1 * h)
-        idx, uv = cand[mine], uv[mine]
-        order = np.lexsort((np.round(uv[:, 1] / h, 6), np.round(uv[:, 0] / h, 6)))
-        idx, uv = idx[order], uv[order]
-        free = ~s.on_feature[idx]
-        if not free.any():
-            continue
-        sides = _arc_sides(arcs, raster, h)
-        own = np.zeros(s.points.shape[0], dtype=bool)
-        own[idx] = True
-        frame = _rim_frame(face, arcs, sides, to2d, s, own, h)
-        args = dict(inside=raster, clamp=_clamp(arcs, sides, h), frame=frame, judge_frame=True)
-        r = repair(uv, free, h, **args)
-        if r.worst >= SQRT3_2 and r.bad <= FEW_BAD:
-            r = split_corners(uv, free, h, r, **args)
-        reports.append(s.put(idx, r, to2d.inverse(r.uv), fi, "sphere"))
+        rep = repair_sphere_face(fi, face, s, h, size)
+        if rep is not None:
+            reports.append(rep)
     return reports
+
+
+def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=None) -> dict | None:
+    """Repair one partial sphere on its stereographic map (see
+    :func:`repair_sphere_faces`): the samples of ``fixed`` (default: the
+    feature samples) stay, the face's other samples are free, the
+    neighbours' samples near its rims are the judged frame.  Returns the
+    face's report, or None where the face is not repaired (it wraps more
+    than about 78° from its centre, a rim is no circle on the map, or no
+    sample is free)."""
+    tol = 1e-7 * size
+    fixed = s.on_feature if fixed is None else np.asarray(fixed, dtype=bool)
+    sph = face._geomAdaptor().Sphere()
+    centre = np.array(sph.Location().Coord())
+    radius = float(sph.Radius())
+    pole = np.array(face.Center().toTuple()) - centre
+    if np.linalg.norm(pole) < 1e-9 * radius:
+        return None
+    pole /= np.linalg.norm(pole)
+    verts, _ = face.tessellate(h / 20, 0.3)
+    reach = (np.array([v.toTuple() for v in verts]) - centre) @ pole
+    if reach.min() <= FACING * radius:
+        return None  # the face wraps too far round for one map
+    to2d = _Stereographic(centre, radius, pole)
+    arcs = _rim_arcs(face, to2d)
+    if arcs is None:
+        return None
+    q = s.points - centre
+    dist = np.linalg.norm(q, axis=1)
+    cand = np.flatnonzero((np.abs(dist - radius) < tol) & (q @ pole > FACING * radius))
+    uv = to2d(s.points[cand])
+    seg = _boundary_segments(face, to2d, h / 20)
+    raster = _Raster(seg, h / RASTER)
+    mine = raster(uv) | (_segment_distance(uv, seg, h / 100) < 0.1 * h)
+    idx, uv = cand[mine], uv[mine]
+    order = np.lexsort((np.round(uv[:, 1] / h, 6), np.round(uv[:, 0] / h, 6)))
+    idx, uv = idx[order], uv[order]
+    free = ~fixed[idx]
+    if not free.any():
+        return None
+    sides = _arc_sides(arcs, raster, h)
+    own = np.zeros(s.points.shape[0], dtype=bool)
+    own[idx] = True
+    frame = _rim_frame(face, arcs, sides, to2d, s, own, h)
+    args = dict(inside=raster, clamp=_clamp(arcs, sides, h), frame=frame, judge_frame=True)
+    r = repair(uv, free, h, **args)
+    if r.worst >= SQRT3_2 and r.bad <= FEW_BAD:
+        r = split_corners(uv, free, h, r, **args)
+    return s.put(idx, r, to2d.inverse(r.uv), fi, "sphere")
