@@ -150,6 +150,65 @@ def _octant_rows(radius: float, n: int, h: float) -> list[np.ndarray]:
     return rows
 
 
+def _pieces(box: FilletedBox, xs, ys, zs, ang, corners) -> list[list[np.ndarray]]:
+    """The rows of the sides, the vertical fillets, the top fillets and the
+    top (each piece a list of rows, each row an (m, 3) array): the sides'
+    and vertical fillets' rows at the heights ``zs``, their columns at
+    ``ys`` or ``xs`` and at the angles ``ang``; the top fillets' rows at the
+    angles ``ang`` round their axes, their columns ``xs`` or ``ys``."""
+    lo, hi, r = box.lo, box.hi, box.radius
+    x0, x1, y0, y1 = lo[0] + r, hi[0] - r, lo[1] + r, hi[1] - r
+    zt = hi[2] - r
+
+    def rows(outer, inner, x, y, z):
+        """Per value u of ``outer``, the row of points (x, y, z)(u, inner)."""
+        return [
+            np.stack([np.broadcast_to(f(u, inner), inner.shape) for f in (x, y, z)], axis=1)
+            for u in outer
+        ]
+
+    out = []
+    for x in (lo[0], hi[0]):
+        out.append(rows(zs, ys, lambda z, c, x=x: x, lambda z, c: c, lambda z, c: z))
+    for y in (lo[1], hi[1]):
+        out.append(rows(zs, xs, lambda z, c: c, lambda z, c, y=y: y, lambda z, c: z))
+    for sx, sy in corners:
+        cx, cy = (x1 if sx > 0 else x0), (y1 if sy > 0 else y0)
+        out.append(
+            rows(
+                zs,
+                ang,
+                lambda z, t, cx=cx, sx=sx: cx + sx * r * np.cos(t),
+                lambda z, t, cy=cy, sy=sy: cy + sy * r * np.sin(t),
+                lambda z, t: z,
+            )
+        )
+    for sy in (-1, 1):
+        cy = y1 if sy > 0 else y0
+        out.append(
+            rows(
+                ang,
+                xs,
+                lambda a, c: c,
+                lambda a, c, cy=cy, sy=sy: cy + sy * r * math.cos(a),
+                lambda a, c: zt + r * math.sin(a),
+            )
+        )
+    for sx in (-1, 1):
+        cx = x1 if sx > 0 else x0
+        out.append(
+            rows(
+                ang,
+                ys,
+                lambda a, c, cx=cx, sx=sx: cx + sx * r * math.cos(a),
+                lambda a, c: c,
+                lambda a, c: zt + r * math.sin(a),
+            )
+        )
+    out.append(rows(ys, xs, lambda y, c: c, lambda y, c: y, lambda y, c: hi[2]))
+    return out
+
+
 def _first(points: np.ndarray, tol: float) -> np.ndarray:
     """Indices of the points not within ``tol`` of an earlier one (in order)."""
     drop = np.zeros(points.shape[0], dtype=bool)
@@ -184,77 +243,18 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
     ys = np.linspace(y0, y1, max(1, round((y1 - y0) / h)) + 1)
     zs = np.linspace(zb, zt, max(1, round((zt - zb) / h)) + 1)[1:]  # the bottom's row is kept
     ang = np.linspace(0.0, math.pi / 2, n + 1)
-    pieces: list[list[np.ndarray]] = []  # each piece a list of rows
-
-    def grid(rows_of, cols, build):
-        return [build(v, cols) for v in rows_of]
-
-    for x in (lo[0], hi[0]):
-        pieces.append(
-            grid(zs, ys, lambda z, c, x=x: np.stack([np.full(c.size, x), c, np.full(c.size, z)], 1))
-        )
-    for y in (lo[1], hi[1]):
-        pieces.append(
-            grid(zs, xs, lambda z, c, y=y: np.stack([c, np.full(c.size, y), np.full(c.size, z)], 1))
-        )
     corners = [(sx, sy) for sx in (-1, 1) for sy in (-1, 1)]
-    for sx, sy in corners:
-        cx, cy = (x1 if sx > 0 else x0), (y1 if sy > 0 else y0)
-        pieces.append(
-            grid(
-                zs,
-                ang,
-                lambda z, t, cx=cx, cy=cy, sx=sx, sy=sy: np.stack(
-                    [cx + sx * r * np.cos(t), cy + sy * r * np.sin(t), np.full(t.size, z)], 1
-                ),
-            )
-        )
-    for sy in (-1, 1):
-        cy = y1 if sy > 0 else y0
-        pieces.append(
-            grid(
-                ang,
-                xs,
-                lambda p, c, cy=cy, sy=sy: np.stack(
-                    [
-                        c,
-                        np.full(c.size, cy + sy * r * math.cos(p)),
-                        np.full(c.size, zt + r * math.sin(p)),
-                    ],
-                    1,
-                ),
-            )
-        )
-    for sx in (-1, 1):
-        cx = x1 if sx > 0 else x0
-        pieces.append(
-            grid(
-                ang,
-                ys,
-                lambda p, c, cx=cx, sx=sx: np.stack(
-                    [
-                        np.full(c.size, cx + sx * r * math.cos(p)),
-                        c,
-                        np.full(c.size, zt + r * math.sin(p)),
-                    ],
-                    1,
-                ),
-            )
-        )
-    pieces.append(
-        grid(ys, xs, lambda y, c: np.stack([c, np.full(c.size, y), np.full(c.size, hi[2])], 1))
-    )
-    octant = _octant_rows(r, n, h)
-    centres = []
-    for sx, sy in corners:
-        c = np.array([x1 if sx > 0 else x0, y1 if sy > 0 else y0, zt])
-        centres.append(c)
-        pieces.append([c + q * np.array([sx, sy, 1.0]) for q in octant])
+    pieces = _pieces(box, xs, ys, zs, ang, corners) + [
+        # the corner octants' latitude rows
+        [c + q * np.array([sx, sy, 1.0]) for q in _octant_rows(r, n, h)]
+        for sx, sy in corners
+        for c in [np.array([x1 if sx > 0 else x0, y1 if sy > 0 else y0, zt])]
+    ]
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     pts, lid, fid = [], [], []
     for rows in pieces:
-        middle = np.vstack(rows)[len(np.vstack(rows)) // 2]
-        face = _nearest_face(middle, faces)
+        middle = rows[len(rows) // 2]
+        face = _nearest_face(middle[len(middle) // 2], faces)
         for row in rows:
             pts.append(row)
             lid += [line] * row.shape[0]
@@ -265,41 +265,44 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
     pts3, lid, fid = pts3[keep], np.array(lid)[keep], np.array(fid)[keep]
     vertices = np.array([v.toTuple() for v in occ.Vertices()])
     feat = cKDTree(vertices).query(pts3)[0] < tol
-    bottom = np.flatnonzero(np.abs(s.points[:, 2] - zb) > tol)
-    s.replace(bottom, pts3, np.where(feat, -1, lid), fid, feat)
+    off_bottom = np.flatnonzero(np.abs(s.points[:, 2] - zb) > tol)
+    s.replace(off_bottom, pts3, np.where(feat, -1, lid), fid, feat)
     laid = {
         f
         for f in range(len(faces))
         if faces[f].geomType() != "PLANE"
         or abs(np.array(faces[f].Center().toTuple())[2] - zb) > tol
     }
-    # each octant repaired on its map; the best answer (lowest worst ratio,
-    # then fewest bad triangles) is mirrored onto the others, whose seams
-    # and neighbours are its mirror images (one answer for all four)
+    # the octants repaired on their maps one after another until one is left
+    # with no triangle above the repair's margin; that one, or the best
+    # (lowest worst ratio, then fewest bad triangles), is mirrored onto the
+    # others, whose seams and neighbours are its mirror images
     octants = []
     for fi, face in enumerate(faces):
-        if face.geomType() != "SPHERE":
-            continue
-        c = np.array(face._geomAdaptor().Sphere().Location().Coord())
-        sign = np.array(
-            [1.0 if c[0] > (x0 + x1) / 2 else -1.0, 1.0 if c[1] > (y0 + y1) / 2 else -1.0, 1.0]
-        )
+        if face.geomType() == "SPHERE":
+            c = np.array(face._geomAdaptor().Sphere().Location().Coord())
+            mid = ((x0 + x1) / 2, (y0 + y1) / 2)
+            sign = np.array([1.0 if c[0] > mid[0] else -1.0, 1.0 if c[1] > mid[1] else -1.0, 1.0])
+            octants.append((fi, face, c, sign))
+    tried = []
+    for fi, face, c, sign in octants:
         rep = repair_sphere_face(
             fi, face, s, h, size, fixed=s.on_feature | _seams(s.points, c, r, tol)
         )
         if rep is not None:
-            octants.append((rep["worst"], rep["bad"], fi, c, sign, rep))
-    if not octants:
+            tried.append((rep["worst"], rep["bad"], fi, c, sign, rep))
+            if rep["bad"] == 0:
+                break
+    if not tried:
         return [], laid
-    worst, bad, best, cb, sb, rep = min(octants, key=lambda o: o[:3])
+    _, _, best, cb, sb, rep = min(tried, key=lambda o: o[:3])
     reports = []
-    for _, _, fi, c, sign, _ in sorted(octants, key=lambda o: o[2]):
+    for fi, _, c, sign in octants:
         if fi != best:
             src = _free_octant(s, cb, sb, r, tol)
-            mirrored = c + (s.points[src] - cb) * (sign * sb)
             s.replace(
                 _free_octant(s, c, sign, r, tol),
-                mirrored,
+                c + (s.points[src] - cb) * (sign * sb),
                 np.full(src.size, -3),
                 np.full(src.size, fi),
                 np.zeros(src.size, dtype=bool),

@@ -31,7 +31,9 @@ N is the even number nearest ``W sqrt(tan(beta)) / h``, so the cells' two
 sides are about ``h / sqrt(tan(beta))`` and ``h sqrt(tan(beta))`` (their
 geometric mean is h); the sweep directions and the sampler's row ratio do
 not apply (the lattice's ratio is the face's ``1 / tan(beta)``).  Taller
-pyramids keep the scan rows and their repair (:mod:`samplers.layers`).
+pyramids, and pyramids so flat that samples across a base edge would be
+closer than ``MIN_GAP`` h (the default's are c apart), keep the scan rows
+and their repair (:mod:`samplers.layers`).
 CadQuery is imported when the functions run.
 """
 
@@ -49,6 +51,7 @@ from .repair import BAD
 
 MAX_RATIO = 0.83  # lateral cells of a larger ratio sin(beta): the pyramid keeps its scan rows
 TIE_SHIFT = 0.02  # samples next to a lateral edge step this far from it (times c)
+MIN_GAP = 0.5  # base and lateral samples closer than this (times h) across a base edge: scan rows
 
 
 @dataclass(frozen=True)
@@ -159,8 +162,10 @@ def _worst(uv: np.ndarray) -> tuple[int, float]:
 def lattice_pyramid(occ, s: Samples, h: float, size: float) -> tuple[list[dict], set[int]]:
     """Lay a right square pyramid out as one lattice (see the module's docstring).
 
-    Replaces all the samples when ``occ`` is such a pyramid and its lateral
-    cells' ratio ``sin(beta)`` is at most ``MAX_RATIO``; does nothing
+    Replaces all the samples when ``occ`` is such a pyramid, its lateral
+    cells' ratio ``sin(beta)`` is at most ``MAX_RATIO`` and the samples
+    nearest to each other across a base edge are at least ``MIN_GAP`` h
+    apart (a flat pyramid's base edges are acute); does nothing
     otherwise.  Samples on the edges belong to the edge's first face (as in
     the scan), the corners and the apex to the first face through them;
     every base row and every lateral row is a scan line.  Returns one
@@ -175,10 +180,15 @@ def lattice_pyramid(occ, s: Samples, h: float, size: float) -> tuple[list[dict],
     tan_beta = pyr.tan_beta
     if tan_beta / math.hypot(1.0, tan_beta) > MAX_RATIO:
         return [], set()
-    adjacency = EdgeFaces(occ)
-    faces = adjacency.faces
     n = pyramid_steps(pyr.width, tan_beta, h)
     c = pyr.width / n
+    # across a base edge (dihedral angle delta, cos(delta) = 1 / tan(beta))
+    # the first samples of one column on either side are c sqrt(tan^2 - 1)
+    # = 2 c height / width apart; the scan's thinning keeps h / 2
+    if c * math.sqrt(max(tan_beta**2 - 1.0, 0.0)) < MIN_GAP * h:
+        return [], set()
+    adjacency = EdgeFaces(occ)
+    faces = adjacency.faces
     a0, apex = pyr.corners[0], pyr.apex
     ex = (pyr.corners[1] - a0) / pyr.width
     ey = (pyr.corners[3] - a0) / pyr.width

@@ -66,3 +66,17 @@ def test_find_pyramid_knows_a_right_square_pyramid_only():
     t = pyr.tan_beta
     assert t / math.hypot(1.0, t) > MAX_RATIO
     assert pyramid_steps(1.0, 1.0, 0.1) == 10 and pyramid_steps(1.0, 1.0, 1.0) == 4
+
+
+def test_a_flat_pyramid_keeps_its_scan_rows():
+    """At height 0.3 on a base of 2 the base edges are 16.7° sharp: one
+    lattice would put a base sample and the lateral one above it 0.29 h
+    apart (2 c height / base), under MIN_GAP; the scan rows and their
+    thinning keep h / 2."""
+    from scipy.spatial import cKDTree
+
+    s = shapes.build("pyramid", base=2.0, height=0.3)
+    r = scan(s)
+    assert not [x for x in r.meta["repairs"] if x["kind"] == "pyramid lattice"]
+    d = cKDTree(r.points).query(r.points, 2)[0][:, 1]
+    assert d.min() >= 0.25 * r.meta["spacing"]
