@@ -183,28 +183,15 @@ def _pieces(box: FilletedBox, xs, ys, zs, ang, corners) -> list[list[np.ndarray]
                 lambda z, t: z,
             )
         )
-    for sy in (-1, 1):
-        cy = y1 if sy > 0 else y0
-        out.append(
-            rows(
-                ang,
-                xs,
-                lambda a, c: c,
-                lambda a, c, cy=cy, sy=sy: cy + sy * r * math.cos(a),
-                lambda a, c: zt + r * math.sin(a),
-            )
-        )
-    for sx in (-1, 1):
-        cx = x1 if sx > 0 else x0
-        out.append(
-            rows(
-                ang,
-                ys,
-                lambda a, c, cx=cx, sx=sx: cx + sx * r * math.cos(a),
-                lambda a, c: c,
-                lambda a, c: zt + r * math.sin(a),
-            )
-        )
+    # the top fillets: along x (round the axes at y0, y1), then along y
+    for along, cols, axes in ((0, xs, (y0, y1)), (1, ys, (x0, x1))):
+        for sign, axis in zip((-1, 1), axes):
+
+            def across(a, c, axis=axis, sign=sign):
+                return axis + sign * r * math.cos(a)
+
+            xy = [lambda a, c: c, across][:: 1 if along == 0 else -1]
+            out.append(rows(ang, cols, *xy, lambda a, c: zt + r * math.sin(a)))
     out.append(rows(ys, xs, lambda y, c: c, lambda y, c: y, lambda y, c: hi[2]))
     return out
 
