@@ -196,15 +196,6 @@ def _pieces(box: FilletedBox, xs, ys, zs, ang, corners) -> list[list[np.ndarray]
     return out
 
 
-def _first(points: np.ndarray, tol: float) -> np.ndarray:
-    """Indices of the points not within ``tol`` of an earlier one (in order)."""
-    drop = np.zeros(points.shape[0], dtype=bool)
-    pairs = cKDTree(points).query_pairs(tol, output_type="ndarray")
-    if pairs.size:
-        drop[pairs.max(axis=1)] = True
-    return np.flatnonzero(~drop)
-
-
 def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[dict], set[int]]:
     """Lay a box with filleted vertical and top edges out as one lattice
     (see the module's docstring).
@@ -215,7 +206,7 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
     as in the scan.  Returns one report per octant (its repair) and the
     indices of the faces laid out (all but the bottom).
     """
-    from .scanline import _nearest_face
+    from .scanline import _nearest_face, _thin
 
     tol = 1e-7 * size
     box = find_filleted_box(occ, tol)
@@ -248,7 +239,7 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
             fid += [face] * row.shape[0]
             line += 1
     pts3 = np.vstack(pts)
-    keep = _first(pts3, tol)
+    keep = _thin(pts3, tol)  # a seam's samples come once, from the first piece
     pts3, lid, fid = pts3[keep], np.array(lid)[keep], np.array(fid)[keep]
     vertices = np.array([v.toTuple() for v in occ.Vertices()])
     feat = cKDTree(vertices).query(pts3)[0] < tol

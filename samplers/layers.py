@@ -478,7 +478,7 @@ def _clamp_lines(lines: list[_Line], h: float):
 
 
 def repair_planar_faces(
-    occ, s: Samples, h: float, size: float, row_dirs=None, skip=frozenset()
+    occ, s: Samples, h: float, size: float, row_dirs=None, skip=frozenset(), again: bool = True
 ) -> list[dict]:
     """Repair the boundary layer of every planar face bounded by circular arcs
     or by straight sharp edges slanted to its scan rows.
@@ -516,7 +516,11 @@ def repair_planar_faces(
     bounded by straight edges only, with the same edges and edge samples,
     get one answer even where a gap was filled on one of them only (a
     prism's two ends; their sides' columns run straight from one to the
-    other).  Returns one report per repaired face.
+    other).  A face still left with at most ``FEW_BAD`` triangles at or
+    above √3/2 is repaired once more from that answer (``again``;
+    fillet_box's bottom: two of 0.884 where its corners' arcs meet the
+    rows, none after the second run).  Returns one report per repaired
+    face.
     """
     reports = []
     done: dict[tuple, object] = {}
@@ -673,6 +677,13 @@ def repair_planar_faces(
             if a.wall >= 0 and a.wall not in walls:
                 walls[a.wall] = pts3[rim & (a.distance(r.uv) < tol)]
     _follow_columns(s, shifts, faces, tol)
+    stuck = {x["face"] for x in reports if x["worst"] >= SQRT3_2 and x["bad"] <= FEW_BAD}
+    if again and stuck:
+        rest = set(range(len(faces))) - stuck
+        redone = {
+            x["face"]: x for x in repair_planar_faces(occ, s, h, size, row_dirs, rest, again=False)
+        }
+        reports = [redone.get(x["face"], x) for x in reports]
     return reports
 
 

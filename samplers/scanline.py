@@ -68,7 +68,6 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from sr33._progress import bar, log, timed
-from validators.conditions import SQRT3_2
 
 from .adjacency import EdgeFaces
 
@@ -858,7 +857,6 @@ def scan(
             from .disks import lattice_disk_faces
             from .fillets import lattice_filleted_box
             from .layers import (
-                FEW_BAD,
                 Samples,
                 lattice_cone_faces,
                 lattice_cylinder_faces,
@@ -882,19 +880,9 @@ def scan(
                 reports += more
             pbar.update(1)
             with timed("sample: planar faces"):
-                rows = [dirs[f] for f in fam]
-                planar = repair_planar_faces(occ, bag, h, size, row_dirs=rows, skip=rings | laid)
-                # a face stuck with a few triangles at or above √3/2 is
-                # repaired once more from its answer (fillet_box's bottom:
-                # two of 0.884 where its corners' arcs meet the rows -> none)
-                stuck = {x["face"] for x in planar if x["worst"] >= SQRT3_2 and x["bad"] <= FEW_BAD}
-                if stuck:
-                    again = repair_planar_faces(
-                        occ, bag, h, size, row_dirs=rows, skip=set(range(len(faces))) - stuck
-                    )
-                    redone = {x["face"]: x for x in again}
-                    planar = [redone.get(x["face"], x) for x in planar]
-                reports += planar
+                reports += repair_planar_faces(
+                    occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=rings | laid
+                )
             pbar.update(1)
             for step, lay in (
                 ("cylinders", lattice_cylinder_faces),
