@@ -6,7 +6,7 @@ slanted edges at once; the boundary layers there, at the base corners
 4 alpha) are where the scan rows and their repair left 2% of the samples
 breaking Condition III-ii (pyramid of height 0.8 on a unit base).  A right
 pyramid whose lateral faces' base angle beta satisfies ``sin(beta) <=
-MAX_RATIO`` (height below about 0.57 of the base) needs no repair at all:
+MAX_RATIO`` (height below about 0.55 of the base) needs no repair at all:
 
 * the base is an N x N square lattice of step ``c = W / N`` (N even),
   its edges' samples included;

@@ -30,7 +30,7 @@ a CadQuery shape:
 * where the rows leave a gap (planes grazing a face: the poles of a sphere),
   extra samples are projected onto the surface until every point of it is
   within h of a sample (their ``line_id`` is -2);
-* a right square pyramid no taller than about 0.57 of its base is laid
+* a right square pyramid no taller than about 0.55 of its base is laid
   out as one lattice, its lateral rows on the base's columns and its
   lateral edges the cells' diagonals (:mod:`samplers.pyramids`); a box
   with filleted vertical and top edges as lattices continued across the
