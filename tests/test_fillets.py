@@ -85,3 +85,20 @@ def test_corner_octants_are_one_repaired_answer(box):
         assert cKDTree(corners[0]).query(q)[0].max() < 1e-12
     # not the latitude rows any more: the repair moved, added or removed samples
     assert any(x["added"] + x["removed"] > 0 for x in reps)
+
+
+def test_the_bottoms_stuck_repair_runs_again(box):
+    """The bottom keeps its scan rows; their boundary-layer repair is left
+    with two triangles of 0.884 where a corner's arc meets the rows, split
+    in vain, and the second run from that answer leaves none above the
+    margin (repair_planar_faces' ``again``)."""
+    from samplers.layers import Samples, repair_planar_faces
+
+    s, r = box
+    bottom = [x for x in r.meta["repairs"] if x["kind"] == "plane"]
+    assert len(bottom) == 1 and bottom[0]["worst"] < np.sqrt(3) / 2
+    # the same repair without the second run, on the plain scan rows
+    plain = scan(s, repair=False)
+    bag = Samples(plain.points, plain.line_id, plain.face_id, plain.on_feature)
+    once = repair_planar_faces(s.solid, bag, r.meta["spacing"], s.size, again=False)
+    assert once[0]["face"] == bottom[0]["face"] and once[0]["worst"] >= np.sqrt(3) / 2
