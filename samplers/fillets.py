@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .layers import Samples
+from .layers import Samples, _revolution_axis
 from .spheres import repair_sphere_face
 
 
@@ -56,12 +56,6 @@ class FilletedBox:
     lo: np.ndarray
     hi: np.ndarray
     radius: float
-
-
-def _axis(face) -> tuple[np.ndarray, np.ndarray]:
-    """Location and unit direction of a cylinder's axis."""
-    ax = face._geomAdaptor().Cylinder().Axis()
-    return np.array(ax.Location().Coord()), np.array(ax.Direction().Coord())
 
 
 def find_filleted_box(occ, tol: float) -> FilletedBox | None:
@@ -105,7 +99,7 @@ def find_filleted_box(occ, tol: float) -> FilletedBox | None:
             continue
         if abs(float(f._geomAdaptor().Cylinder().Radius()) - r) > tol:
             return None
-        o, d = _axis(f)
+        o, d = _revolution_axis(f)
         a = int(np.argmax(np.abs(d)))
         if abs(abs(d[a]) - 1.0) > 1e-9:
             return None
@@ -173,7 +167,7 @@ def _pieces(box: FilletedBox, xs, ys, zs, ang, corners) -> list[list[np.ndarray]
     for y in (lo[1], hi[1]):
         out.append(rows(zs, xs, lambda z, c: c, lambda z, c, y=y: y, lambda z, c: z))
     for sx, sy in corners:
-        cx, cy = (x1 if sx > 0 else x0), (y1 if sy > 0 else y0)
+        cx, cy, _ = _corner(box, sx, sy)
         out.append(
             rows(
                 zs,
@@ -222,11 +216,11 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
     zs = np.linspace(zb, zt, max(1, round((zt - zb) / h)) + 1)[1:]  # the bottom's row is kept
     ang = np.linspace(0.0, math.pi / 2, n + 1)
     corners = [(sx, sy) for sx in (-1, 1) for sy in (-1, 1)]
+    octant = _octant_rows(r, n, h)
     pieces = _pieces(box, xs, ys, zs, ang, corners) + [
         # the corner octants' latitude rows
-        [c + q * np.array([sx, sy, 1.0]) for q in _octant_rows(r, n, h)]
+        [_corner(box, sx, sy) + q * np.array([sx, sy, 1.0]) for q in octant]
         for sx, sy in corners
-        for c in [np.array([x1 if sx > 0 else x0, y1 if sy > 0 else y0, zt])]
     ]
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     pts, lid, fid = [], [], []
@@ -258,9 +252,8 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
     octants = []
     for fi, face in enumerate(faces):
         if face.geomType() == "SPHERE":
-            c = np.array(face._geomAdaptor().Sphere().Location().Coord())
-            mid = ((x0 + x1) / 2, (y0 + y1) / 2)
-            sign = np.array([1.0 if c[0] > mid[0] else -1.0, 1.0 if c[1] > mid[1] else -1.0, 1.0])
+            c = _revolution_axis(face)[0]
+            sign = np.array([np.sign(c[0] - (x0 + x1) / 2), np.sign(c[1] - (y0 + y1) / 2), 1.0])
             octants.append((fi, face, c, sign))
     tried = []
     for fi, face, c, sign in octants:
@@ -274,31 +267,41 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
     if not tried:
         return [], laid
     _, _, best, cb, sb, rep = min(tried, key=lambda o: o[:3])
+    answer = (s.points[_free_octant(s, cb, sb, r, tol)] - cb) * sb  # in the octant's frame
     reports = []
     for fi, _, c, sign in octants:
         if fi != best:
-            src = _free_octant(s, cb, sb, r, tol)
             s.replace(
                 _free_octant(s, c, sign, r, tol),
-                c + (s.points[src] - cb) * (sign * sb),
-                np.full(src.size, -3),
-                np.full(src.size, fi),
-                np.zeros(src.size, dtype=bool),
+                c + answer * sign,
+                np.full(answer.shape[0], -3),
+                np.full(answer.shape[0], fi),
+                np.zeros(answer.shape[0], dtype=bool),
             )
         reports.append({**rep, "face": fi, "kind": "filleted corner", "from": best})
     return reports, laid
 
 
+def _corner(box: FilletedBox, sx: float, sy: float) -> np.ndarray:
+    """The centre of the corner sphere on the (sx, sy) side (signs of x, y)."""
+    lo, hi, r = box.lo, box.hi, box.radius
+    return np.array(
+        [hi[0] - r if sx > 0 else lo[0] + r, hi[1] - r if sy > 0 else lo[1] + r, hi[2] - r]
+    )
+
+
+def _on_sphere(points: np.ndarray, centre: np.ndarray, radius: float, tol: float) -> np.ndarray:
+    return np.abs(np.linalg.norm(points - centre, axis=1) - radius) < tol
+
+
 def _seams(points: np.ndarray, centre: np.ndarray, radius: float, tol: float) -> np.ndarray:
     """The samples on a corner sphere's seams: on the sphere and on one of
     the three coordinate planes through its centre."""
-    q = points - centre
-    on = np.abs(np.linalg.norm(q, axis=1) - radius) < tol
-    return on & (np.abs(q) < tol).any(axis=1)
+    on_plane = (np.abs(points - centre) < tol).any(axis=1)
+    return _on_sphere(points, centre, radius, tol) & on_plane
 
 
 def _free_octant(s: Samples, centre: np.ndarray, sign: np.ndarray, radius: float, tol: float):
     """Indices of an octant's samples off its seams and off the features."""
-    q = (s.points - centre) * sign
-    on = (np.abs(np.linalg.norm(q, axis=1) - radius) < tol) & (q > tol).all(axis=1)
-    return np.flatnonzero(on & ~s.on_feature)
+    inside = ((s.points - centre) * sign > tol).all(axis=1)
+    return np.flatnonzero(_on_sphere(s.points, centre, radius, tol) & inside & ~s.on_feature)

@@ -1265,9 +1265,11 @@ def _repair_pole(ring, columns, faces, t: float, end: int):
 
 
 def _revolution_axis(face):
-    """(point, unit direction) of a cone's or sphere's axis."""
+    """(point, unit direction) of a cone's, cylinder's or sphere's axis
+    (a sphere's point is its centre)."""
     g = face._geomAdaptor()
-    pos = (g.Cone() if face.geomType() == "CONE" else g.Sphere()).Position()
+    kind = {"CONE": "Cone", "CYLINDER": "Cylinder"}.get(face.geomType(), "Sphere")
+    pos = getattr(g, kind)().Position()
     return np.array(pos.Location().Coord()), np.array(pos.Direction().Coord())
 
 

@@ -47,7 +47,7 @@ from scipy.spatial import Delaunay
 
 from .adjacency import EdgeFaces
 from .layers import Samples
-from .repair import BAD
+from .repair import BAD, triangle_ratios
 
 MAX_RATIO = 0.83  # lateral cells of a larger ratio sin(beta): the pyramid keeps its scan rows
 TIE_SHIFT = 0.02  # samples next to a lateral edge step this far from it (times c)
@@ -152,10 +152,7 @@ def _worst(uv: np.ndarray) -> tuple[int, float]:
     """Triangles at or above the repair's margin, and the largest ratio
     (second-longest over longest edge), of the Delaunay triangulation of a
     face's samples in its plane."""
-    t = Delaunay(uv).simplices
-    e = np.stack([uv[t[:, 1]] - uv[t[:, 0]], uv[t[:, 2]] - uv[t[:, 1]], uv[t[:, 0]] - uv[t[:, 2]]])
-    sides = np.sort(np.linalg.norm(e, axis=2).T, axis=1)
-    ratio = sides[:, 1] / sides[:, 2]
+    ratio = triangle_ratios(uv, Delaunay(uv).simplices)
     return int(np.count_nonzero(ratio >= BAD)), float(ratio.max())
 
 

@@ -77,6 +77,14 @@ class Repaired:
     worst: float
 
 
+def triangle_ratios(pts: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Per triangle, its second-longest edge over its longest (Condition
+    III-ii asks for less than √3/2)."""
+    p = pts[tri]
+    length = np.sort(np.linalg.norm(p - p[:, [1, 2, 0]], axis=2), axis=1)
+    return length[:, 1] / length[:, 2]
+
+
 def rotate(p: np.ndarray, angle) -> np.ndarray:
     """Points (k, 2) turned about the origin by ``angle`` (a scalar or one per point)."""
     c, s = np.cos(angle), np.sin(angle)
@@ -646,9 +654,7 @@ def _corner_wedge(r: Repaired, fixed: np.ndarray, inside) -> tuple[int, np.ndarr
     except QhullError:
         return None
     tri = tri[inside(r.uv[tri].mean(axis=1))]
-    p = r.uv[tri]
-    length = np.sort(np.linalg.norm(p - p[:, [1, 2, 0]], axis=2), axis=1)
-    rho = length[:, 1] / length[:, 2]
+    rho = triangle_ratios(r.uv, tri)
     for t in np.flatnonzero(rho >= SQRT3_2)[np.argsort(-rho[rho >= SQRT3_2], kind="stable")]:
         for k in range(3):
             v = int(tri[t, k])
