@@ -867,21 +867,20 @@ def scan(
             from .spheres import repair_sphere_faces
 
             bag = Samples(points, line_id, face_id, on_feature)
-            with timed("sample: pyramids"):
-                reports, laid = lattice_pyramid(occ, bag, h, size)
-            pbar.update(1)
-            with timed("sample: filleted boxes"):
-                more, boxed = lattice_filleted_box(occ, bag, h, size)
+            laid: set[int] = set()  # faces laid out whole: no boundary-layer repair
+            for step, layout in (
+                ("pyramids", lattice_pyramid),
+                ("filleted boxes", lattice_filleted_box),
+                ("disks", lattice_disk_faces),
+            ):
+                with timed(f"sample: {step}"):
+                    more, done = layout(occ, bag, h, size)
                 reports += more
-                laid |= boxed
-            pbar.update(1)
-            with timed("sample: disks"):
-                more, rings = lattice_disk_faces(occ, bag, h, size)
-                reports += more
-            pbar.update(1)
+                laid |= done
+                pbar.update(1)
             with timed("sample: planar faces"):
                 reports += repair_planar_faces(
-                    occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=rings | laid
+                    occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=laid
                 )
             pbar.update(1)
             for step, lay in (
