@@ -15,16 +15,15 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
-from gui._pv import pyvista  # noqa: E402
+from sr33.gui import pyvista  # noqa: E402
 
 pv = pyvista(off_screen=True)
 
-from gui import LAYERS, Inspector  # noqa: E402
-from samplers import shapes  # noqa: E402
-from samplers.scanline import scan  # noqa: E402
 from sr33 import reconstruct  # noqa: E402
+from sr33.gui import LAYERS, Inspector  # noqa: E402
+from sr33.samplers import shapes  # noqa: E402
+from sr33.samplers.scanline import scan  # noqa: E402
 
 
 def main(argv=None) -> int:

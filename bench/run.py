@@ -24,7 +24,7 @@ Targets (2-core reference machine): cube (6144 points, k = 33) under 1 s,
 ratio at most 50 on every set.  They are checked and printed, but a missed
 target does not change the exit status (only a crash of sr33 does).
 
-Topology of every output comes from ``validators.mesh_stats``: open edges
+Topology of every output comes from ``sr33.validators.mesh_stats``: open edges
 (used by one triangle), overloaded edges (by three or more), Euler
 characteristic and connected components, next to ``Reconstruction.success``.
 
@@ -70,12 +70,10 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
 
 import sr33  # noqa: E402
 from sr33.io import read_mesh, read_points  # noqa: E402
-from validators import mesh_stats  # noqa: E402
+from sr33.validators import mesh_stats  # noqa: E402
 
 # every step reported by Reconstruction.timings, in pipeline order
 STEPS = (

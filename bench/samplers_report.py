@@ -6,7 +6,7 @@ B-rep's), distance of the samples to the CAD surface (OCC's exact
 BRepExtrema distance, as a multiple of the shape's size), coverage (largest
 distance from the truth surface to the nearest sample, in h), the closest
 pair (in h), nearest-neighbour spacing, Condition III by the validators'
-geodesic check (``validators.conditions.sample_conditions``: DT_M on the
+geodesic check (``sr33.validators.conditions.sample_conditions``: DT_M on the
 refined truth with the samples inserted; worst ratio, share of samples in a
 violating triangle, largest degree), seconds to build and to sample, and the
 reconstruction's open/overloaded edges and Euler characteristic next to the
@@ -27,15 +27,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
-from samplers import shapes  # noqa: E402
-from samplers.scanline import scan  # noqa: E402
 from sr33 import reconstruct  # noqa: E402
 from sr33.io import write_text  # noqa: E402
-from validators import mesh_stats  # noqa: E402
-from validators.conditions import sample_conditions  # noqa: E402
-from validators.fidelity import surface_points  # noqa: E402
+from sr33.samplers import shapes  # noqa: E402
+from sr33.samplers.scanline import scan  # noqa: E402
+from sr33.validators import mesh_stats  # noqa: E402
+from sr33.validators.conditions import sample_conditions  # noqa: E402
+from sr33.validators.fidelity import surface_points  # noqa: E402
 
 
 def surface_distance(solid, points: np.ndarray) -> np.ndarray:

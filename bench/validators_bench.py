@@ -1,8 +1,8 @@
 """Speed of the validators (benchmark, not a timed test).
 
-- topology (``validators.signature`` and ``mesh_stats``) of a 1,000,000-triangle
+- topology (``sr33.validators.signature`` and ``mesh_stats``) of a 1,000,000-triangle
   torus mesh;
-- sample conditions (``validators.sample_conditions``) for 10,000 samples on
+- sample conditions (``sr33.validators.sample_conditions``) for 10,000 samples on
   a sphere whose truth mesh has 163,842 vertices.
 
 Median of ``--repeats`` runs.  Run: ``.venv/bin/python bench/validators_bench.py``.
@@ -19,12 +19,11 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
+from sr33.validators import mesh_stats  # noqa: E402
+from sr33.validators.conditions import sample_conditions  # noqa: E402
+from sr33.validators.signature import signature  # noqa: E402
 from tests.meshes import torus  # noqa: E402
-from validators import mesh_stats  # noqa: E402
-from validators.conditions import sample_conditions  # noqa: E402
-from validators.signature import signature  # noqa: E402
 
 
 def timed(fn, repeats: int) -> float:

@@ -1,8 +1,12 @@
 """The PyVista inspector of sr33 reconstructions (``sr33 view``).
 
-PyVista is imported through :mod:`gui._pv` only.
+PyVista is imported through :mod:`sr33.gui._pv` only.
 """
 
-from .inspector import COLOURS, LAYERS, Inspector, InspectorState
+if __name__ != "sr33.gui":  # the folder installs as sr33.gui (pyproject.toml)
+    raise ImportError(f"this folder is sr33.gui; import it by that name, not {__name__}")
 
-__all__ = ["COLOURS", "LAYERS", "Inspector", "InspectorState"]
+from ._pv import has_display, pyvista  # noqa: E402
+from .inspector import COLOURS, LAYERS, Inspector, InspectorState  # noqa: E402
+
+__all__ = ["COLOURS", "LAYERS", "Inspector", "InspectorState", "has_display", "pyvista"]

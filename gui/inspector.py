@@ -24,10 +24,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from sr33 import Reconstruction, k_neighbourhoods, reconstruct, trivial_isometric_cycles
-from validators.conditions import local_delaunay
-from validators.signature import signature
-from validators.topology import edge_uses, mesh_stats
+from sr33.cycles import trivial_isometric_cycles
+from sr33.reconstruct import Reconstruction, reconstruct
+from sr33.rng import k_neighbourhoods
+from sr33.validators.conditions import local_delaunay
+from sr33.validators.signature import signature
+from sr33.validators.topology import edge_uses, mesh_stats
 
 from ._pv import pyvista
 

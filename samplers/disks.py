@@ -18,7 +18,7 @@ row:
   cylinder or cone across a rim (laid out from the rims afterwards) keeps
   the disk's columns;
 * where a ring halves, and round the centre, the triangles come out
-  slightly too regular; :func:`samplers.repair.repair` mends them, the
+  slightly too regular; :func:`sr33.samplers.repair.repair` mends them, the
   rims held fixed.
 
 The angles start from one direction per plane orientation (parallel faces,
@@ -34,8 +34,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .adjacency import EdgeFaces
-from .layers import Samples, _goes_round, _halving_count, _perpendicular, _radial_clamp
+from .chart import halving_count, radial_clamp
+from .faces import goes_round, perpendicular
 from .repair import MOVABLE, repair
+from .samples import Samples
 
 HALVE_GAP = 0.75  # a ring halves its columns rather than let gaps fall below this (times t)
 
@@ -95,7 +97,7 @@ def round_faces(adjacency: EdgeFaces, tol: float) -> list[RoundFace]:
     qualifies when across each circle lies nothing (an open rim), a full
     cone (its rings start from the rim), or a full cylinder whose other rim
     also bounds a qualifying face (so that both rims carry the same
-    columns, :func:`samplers.layers.lattice_cylinder_faces`).
+    columns, :func:`sr33.samplers.layers.lattice_cylinder_faces`).
     """
     faces = adjacency.faces
     found = {fi: r for fi, f in enumerate(faces) if (r := _as_round(fi, f, tol)) is not None}
@@ -115,8 +117,8 @@ def _rim_ok(fi: int, edge, adjacency: EdgeFaces, found) -> bool:
         return True
     face = adjacency.faces[other]
     if face.geomType() == "CONE":
-        return _goes_round(face)
-    if face.geomType() != "CYLINDER" or not _goes_round(face):
+        return goes_round(face)
+    if face.geomType() != "CYLINDER" or not goes_round(face):
         return False
     for e in face.Edges():
         if e.geomType() == "CIRCLE" and not e.isSame(edge):
@@ -165,7 +167,7 @@ def ring_plan(radii: tuple[float, ...], h: float) -> tuple[float, list[tuple[flo
         top = max(0, math.floor(math.log2(2 * math.pi * outer / (HALVE_GAP * t * base))))
         count = rows + 1
     else:
-        n = _halving_count(2 * math.pi * outer / h)
+        n = halving_count(2 * math.pi * outer / h)
         top = 0
         while n > 5 and n % 2 == 0:
             n //= 2
@@ -221,7 +223,7 @@ def _layout(radii: tuple[float, ...], h: float) -> _Layout:
     rim = (ring == 0) | ((ring == len(rings) - 1) & (not disk))
     free = near & ~rim
     lo = radii[1] + 0.25 * t if len(radii) > 1 else 0.0
-    clamp = _radial_clamp(lo, radii[0] - 0.25 * t)
+    clamp = radial_clamp(lo, radii[0] - 0.25 * t)
 
     def inside(c: np.ndarray) -> np.ndarray:
         r = np.linalg.norm(c, axis=1)
@@ -256,7 +258,7 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
             cache[key] = _layout(rf.radii, h)
         lay = cache[key]
         uv, rim, ring = lay.uv, lay.rim, lay.ring
-        ex = _perpendicular(rf.normal)
+        ex = perpendicular(rf.normal)
         ey = np.cross(rf.normal, ex)
         q = s.points - rf.centre
         off = q @ rf.normal

@@ -19,10 +19,10 @@ natural lattice that continues across the seams:
   top fillets' rows where those end on it and its equator carries the
   vertical fillet's columns; each circle is divided into equal steps of
   about h.  The octant is then repaired on its stereographic map
-  (:func:`samplers.spheres.repair_sphere_face`), its seams' samples fixed
+  (:func:`sr33.samplers.spheres.repair_sphere_face`), its seams' samples fixed
   and the fillets' and the top's samples near them as the judged frame;
 * the bottom keeps its scan rows and the boundary-layer repair of planar
-  faces (:func:`samplers.layers.repair_planar_faces`).
+  faces (:func:`sr33.samplers.layers.repair_planar_faces`).
 
 Everything but the octants is a lattice of near-squares (ratio below
 0.75).  A box filleted otherwise (all edges, or the bottom's too) is left
@@ -37,7 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .layers import Samples, _revolution_axis
+from .faces import exact_bounds, nearest_face, revolution_axis, thin
+from .samples import Samples
 from .spheres import repair_sphere_face
 
 
@@ -66,15 +67,13 @@ def find_filleted_box(occ, tol: float) -> FilletedBox | None:
     cylinders on the vertical edges' fillet axes and four horizontal ones
     on the top edges', all within ``tol`` of that geometry.
     """
-    from .scanline import _exact_bounds
-
     faces = occ.Faces()
     kinds = [f.geomType() for f in faces]
     if len(faces) != 18 or sorted(kinds) != sorted(
         ["PLANE"] * 6 + ["CYLINDER"] * 8 + ["SPHERE"] * 4
     ):
         return None
-    lo, hi = _exact_bounds(occ)
+    lo, hi = exact_bounds(occ)
     spheres = [f._geomAdaptor().Sphere() for f, k in zip(faces, kinds) if k == "SPHERE"]
     r = float(spheres[0].Radius())
     if any(abs(float(sp.Radius()) - r) > tol for sp in spheres):
@@ -99,7 +98,7 @@ def find_filleted_box(occ, tol: float) -> FilletedBox | None:
             continue
         if abs(float(f._geomAdaptor().Cylinder().Radius()) - r) > tol:
             return None
-        o, d = _revolution_axis(f)
+        o, d = revolution_axis(f)
         a = int(np.argmax(np.abs(d)))
         if abs(abs(d[a]) - 1.0) > 1e-9:
             return None
@@ -200,8 +199,6 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
     as in the scan.  Returns one report per octant (its repair) and the
     indices of the faces laid out (all but the bottom).
     """
-    from .scanline import _nearest_face, _thin
-
     tol = 1e-7 * size
     box = find_filleted_box(occ, tol)
     if box is None:
@@ -226,14 +223,14 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
     pts, lid, fid = [], [], []
     for rows in pieces:
         middle = rows[len(rows) // 2]
-        face = _nearest_face(middle[len(middle) // 2], faces)
+        face = nearest_face(middle[len(middle) // 2], faces)
         for row in rows:
             pts.append(row)
             lid += [line] * row.shape[0]
             fid += [face] * row.shape[0]
             line += 1
     pts3 = np.vstack(pts)
-    keep = _thin(pts3, tol)  # a seam's samples come once, from the first piece
+    keep = thin(pts3, tol)  # a seam's samples come once, from the first piece
     pts3, lid, fid = pts3[keep], np.array(lid)[keep], np.array(fid)[keep]
     vertices = np.array([v.toTuple() for v in occ.Vertices()])
     feat = cKDTree(vertices).query(pts3)[0] < tol
@@ -252,7 +249,7 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
     octants = []
     for fi, face in enumerate(faces):
         if face.geomType() == "SPHERE":
-            c = _revolution_axis(face)[0]
+            c = revolution_axis(face)[0]
             sign = np.array([np.sign(c[0] - (x0 + x1) / 2), np.sign(c[1] - (y0 + y1) / 2), 1.0])
             octants.append((fi, face, c, sign))
     tried = []

@@ -9,7 +9,7 @@ III-ii.  This module mends that, face by face:
   the plane is axis-aligned, so that parallel faces of a prism get the same
   answer and a hole's two rims line up).  Samples on a sharp circular edge
   slide along it, samples near it move freely, corners, straight-edge
-  samples and the rest of the lattice stay (:func:`samplers.repair.repair`);
+  samples and the rest of the lattice stay (:func:`sr33.samplers.repair.repair`);
 * :func:`lattice_cylinder_faces`: each full cylinder becomes the lattice its
   two (now final) rims span;
 * :func:`lattice_cone_faces`: each full cone with a sampled rim becomes
@@ -27,146 +27,34 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
-from validators.conditions import SQRT3_2
+from sr33.mesh import SQRT3_2, triangle_ratios
 
 from .adjacency import EdgeFaces
+from .chart import (
+    Arc,
+    Raster,
+    arc_clamp,
+    arc_sides,
+    halving_count,
+    radial_clamp,
+    segment_distance,
+)
+from .faces import boundary_segments, goes_round, perpendicular, revolution_axis, row_cosine
 from .repair import GAP, MOVABLE, Repaired, copies, repair, split_corners
-from .scanline import row_cosine
+from .samples import Samples
 
 LAYER = 2.5  # samples within this many h of a circular edge may move
 RASTER = 8  # inside tests on a grid of h / RASTER
 END_GAP = 0.8  # a ring's column ends where its gap falls below this (times the row step)
 END_MERGED = 1.65  # ... unless the merged gap would exceed this
 NARROW = 0.6  # ... or it ends anyway once a gap is below this (times the row step)
-ARC_MARGIN = 0.5  # free samples keep this far (times h) from a cylinder's rim (else h / 4)
 LINE_EDITS = 40  # edits on a face with slanted straight edges only
 FOLLOW_EDITS = 160  # ... when some of them slide with the columns of the face across
 RETRY_WIDE = 1.2  # a stuck face's repair runs again with circumradii up to this (times h)
 FEW_BAD = 10  # a repair left with at most this many bad triangles gets its corners split
 
 
-@dataclass
-class Samples:
-    """The sample arrays of :func:`samplers.scanline.scan`, edited in place by the repairs."""
-
-    points: np.ndarray
-    line_id: np.ndarray
-    face_id: np.ndarray
-    on_feature: np.ndarray
-
-    def replace(self, drop: np.ndarray, points, line_id, face_id, on_feature) -> None:
-        keep = np.ones(self.points.shape[0], dtype=bool)
-        keep[drop] = False
-        self.points = np.vstack([self.points[keep], points])
-        self.line_id = np.r_[self.line_id[keep], line_id].astype(np.int64)
-        self.face_id = np.r_[self.face_id[keep], face_id].astype(np.int64)
-        self.on_feature = np.r_[self.on_feature[keep], on_feature].astype(bool)
-
-    def put(self, idx: np.ndarray, r: Repaired, points: np.ndarray, face: int, kind: str) -> dict:
-        """Replace the samples ``idx`` by the answer ``r`` of their repair
-        (its samples at ``points``, in 3-D): a sample it kept keeps its
-        line, face and feature flag; one it added is on line -3, on
-        ``face``, off the features.  Returns the face's report."""
-        src = np.where(r.origin >= 0, idx[np.maximum(r.origin, 0)], -1)
-        moved = src >= 0
-        was = np.maximum(src, 0)
-        self.replace(
-            idx,
-            points,
-            np.where(moved, self.line_id[was], -3),
-            np.where(moved, self.face_id[was], face),
-            np.where(moved, self.on_feature[was], False),
-        )
-        return {
-            "face": face,
-            "kind": kind,
-            "samples": int(idx.size),
-            "added": int((~moved).sum()),
-            "removed": int(idx.size - moved.sum()),
-            "bad": r.bad,
-            "worst": r.worst,
-        }
-
-
-class _Raster:
-    """Inside test of a 2-D domain given by its boundary segments (even-odd rule)."""
-
-    def __init__(self, segments: np.ndarray, cell: float):
-        lo = segments.reshape(-1, 2).min(axis=0) - 2 * cell
-        hi = segments.reshape(-1, 2).max(axis=0) + 2 * cell
-        self.lo, self.cell = lo, cell
-        nx, ny = (np.ceil((hi - lo) / cell).astype(int) + 1).tolist()
-        ys = lo[1] + (np.arange(ny) + 0.5) * cell
-        xs = lo[0] + (np.arange(nx) + 0.5) * cell
-        a, b = segments[:, 0], segments[:, 1]
-        y0, y1 = a[:, 1], b[:, 1]
-        grid = np.zeros((ny, nx), dtype=bool)
-        for j, y in enumerate(ys):
-            cross = (y0 <= y) != (y1 <= y)
-            if not cross.any():
-                continue
-            t = (y - y0[cross]) / (y1[cross] - y0[cross])
-            x = np.sort(a[cross, 0] + t * (b[cross, 0] - a[cross, 0]))
-            count = np.searchsorted(x, xs)
-            grid[j] = count % 2 == 1
-        self.grid = grid
-
-    def __call__(self, pts: np.ndarray) -> np.ndarray:
-        ij = np.floor((pts - self.lo) / self.cell).astype(np.int64)
-        ny, nx = self.grid.shape
-        ok = (ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny)
-        out = np.zeros(pts.shape[0], dtype=bool)
-        out[ok] = self.grid[ij[ok, 1], ij[ok, 0]]
-        return out
-
-
-def _boundary_segments(face, to2d, tol: float) -> np.ndarray:
-    """Boundary edges of the face's own fine tessellation, in 2-D, as (s, 2, 2)."""
-    verts, tris = face.tessellate(tol, 0.05)
-    v = np.array([q.toTuple() for q in verts])
-    t = np.array(tris, dtype=np.int64).reshape(-1, 3)
-    e = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
-    uniq, counts = np.unique(e, axis=0, return_counts=True)
-    free = uniq[counts == 1]
-    return to2d(v)[free]
-
-
-@dataclass(frozen=True)
-class _Arc:
-    centre: np.ndarray  # 2-D
-    radius: float
-    start: float  # the arc runs from angle start to start + span (0, 2 pi when closed)
-    span: float
-    closed: bool
-    slides: bool  # its samples slide along it (it bounds a full cylinder)
-    wall: int = -1  # the index of that full cylinder's face, else -1
-
-    @classmethod
-    def through(cls, centre, radius: float, s, m, f, slides: bool = False, wall: int = -1):
-        """The open arc of that circle from ``s`` through ``m`` to ``f`` (2-D points)."""
-        a0, am, a1 = (math.atan2(*(np.asarray(q) - centre)[::-1]) for q in (s, m, f))
-        span = (a1 - a0) % (2 * math.pi)
-        if (am - a0) % (2 * math.pi) > span:  # the arc runs the other way round
-            a0, span = a1, 2 * math.pi - span
-        return cls(centre, radius, a0, span, False, slides, wall)
-
-    def distance(self, p: np.ndarray) -> np.ndarray:
-        return np.abs(np.linalg.norm(p - self.centre, axis=1) - self.radius)
-
-    def project(self, p: np.ndarray, margin: float) -> np.ndarray:
-        d = p - self.centre
-        ang = np.arctan2(d[:, 1], d[:, 0])
-        if not self.closed:
-            rel = (ang - self.start) % (2 * math.pi)
-            lo, hi = margin / self.radius, self.span - margin / self.radius
-            # a point past either end goes to the nearer end
-            past = rel > self.span + (2 * math.pi - self.span) / 2
-            rel = np.where(past, lo, np.clip(rel, lo, hi))
-            ang = self.start + rel
-        return self.centre + self.radius * np.stack([np.cos(ang), np.sin(ang)], axis=1)
-
-
-def _arcs(face, to2d, across=()) -> list[_Arc]:
+def _arcs(face, to2d, across=()) -> list[Arc]:
     """The circular edges of a planar face.  ``across`` (its edges and the
     face on the other side, from :meth:`EdgeFaces.across`) tells which arcs bound
     a full cylinder: only their samples slide.  The cylinder is laid out
@@ -180,15 +68,15 @@ def _arcs(face, to2d, across=()) -> list[_Arc]:
         if e.geomType() != "CIRCLE":
             continue
         other, wall = next(((f, k) for x, f, k in across if x.isSame(e)), (None, -1))
-        slides = other is not None and other.geomType() == "CYLINDER" and _goes_round(other)
+        slides = other is not None and other.geomType() == "CYLINDER" and goes_round(other)
         wall = wall if slides else -1
         c = to2d(np.array([e.arcCenter().toTuple()]))[0]
         r = float(e.radius())
         if e.IsClosed():
-            out.append(_Arc(c, r, 0.0, 2 * math.pi, True, slides, wall))
+            out.append(Arc(c, r, 0.0, 2 * math.pi, True, slides, wall))
             continue
         s, m, f = (to2d(np.array([e.positionAt(x).toTuple()]))[0] for x in (0.0, 0.5, 1.0))
-        out.append(_Arc.through(c, r, s, m, f, slides, wall))
+        out.append(Arc.through(c, r, s, m, f, slides, wall))
     return out
 
 
@@ -213,7 +101,7 @@ def _project_onto(curves: list, margin: float):
     return project
 
 
-def _ghosts(arcs: list[_Arc], sides: list[float], h: float):
+def _ghosts(arcs: list[Arc], sides: list[float], h: float):
     """The neighbouring face unfolded across the arcs: rows h and 2h beyond each arc sample.
 
     The cylinder (or cone, or sphere) on the other side of a circular edge
@@ -265,58 +153,6 @@ def _joined(fns):
     return lambda p: np.vstack([f(p) for f in fns])
 
 
-def _arc_sides(arcs: list[_Arc], raster: _Raster, h: float) -> list[float]:
-    """Per arc, +1 when the face lies inside its circle, -1 when outside."""
-    sides = []
-    for a in arcs:
-        mid = a.start + a.span / 2
-        probe = a.centre + (a.radius - 0.5 * h) * np.array([[math.cos(mid), math.sin(mid)]])
-        sides.append(1.0 if raster(probe)[0] else -1.0)
-    return sides
-
-
-def _clamp(arcs: list[_Arc], sides: list[float], h: float):
-    """Keep free samples on the face side of every arc, at least ``ARC_MARGIN`` h
-    from a full cylinder's rim (nearer, a sample makes a Delaunay triangle with
-    the wall's first row across the rim, which the repair does not judge) and
-    h / 4 from other arcs."""
-
-    def clamp(p: np.ndarray) -> np.ndarray:
-        out = p.copy()
-        for a, side in zip(arcs, sides):
-            w = out - a.centre
-            r = np.linalg.norm(w, axis=1)
-            ang = (np.arctan2(w[:, 1], w[:, 0]) - a.start) % (2 * math.pi)
-            within = a.closed | (ang <= a.span)
-            inward = side * (a.radius - r)  # distance into the face from the arc
-            margin = (ARC_MARGIN if a.slides else 0.25) * h
-            bad = within & (inward < margin) & (r > 1e-12)
-            if bad.any():
-                target = a.radius - side * margin
-                out[bad] = a.centre + w[bad] / r[bad, None] * target
-        return out
-
-    return clamp
-
-
-def _radial_clamp(lo: float, hi: float):
-    """Keep points at a distance from the origin within [lo, hi] (the origin stays)."""
-
-    def clamp(p: np.ndarray) -> np.ndarray:
-        r = np.linalg.norm(p, axis=1)
-        s = np.clip(r, lo, hi) / np.maximum(r, 1e-300)
-        return np.where((r > 0)[:, None], p * s[:, None], p)
-
-    return clamp
-
-
-def _perpendicular(v: np.ndarray) -> np.ndarray:
-    """A unit vector perpendicular to ``v``: ``v`` crossed with the coordinate
-    axis least aligned with it (a fixed choice, so frames are reproducible)."""
-    u = np.cross(v, np.eye(3)[int(np.argmin(np.abs(v)))])
-    return u / np.linalg.norm(u)
-
-
 def _plane_frame(face):
     n = np.array(face.normalAt().toTuple())
     k = int(np.argmax(np.abs(n)))
@@ -324,7 +160,7 @@ def _plane_frame(face):
         u = np.eye(3)[(k + 1) % 3]
         v = np.eye(3)[(k + 2) % 3]
     else:
-        u = _perpendicular(n)
+        u = perpendicular(n)
         v = np.cross(n, u)
     o = np.array(face.Center().toTuple())
     o = n * float(n @ o)  # the plane's point nearest the origin: parallel faces share u, v
@@ -497,7 +333,7 @@ def repair_planar_faces(
     face, the normal of its scan planes) tells which straight edges are
     slanted; without it only arcs are repaired.  Faces are taken in order,
     each seeing the samples of the ones before it as they were left; faces
-    in ``skip`` (laid out already, :func:`samplers.disks.lattice_disk_faces`)
+    in ``skip`` (laid out already, :func:`sr33.samplers.disks.lattice_disk_faces`)
     are left alone.
     A full cylinder's rim on a face that is not congruent to the one its
     other rim lies on (cutcube's hole: one end also has the scoop's arc)
@@ -509,7 +345,7 @@ def repair_planar_faces(
     to ``RETRY_WIDE`` h, and the lower worst ratio is kept (conebox's top:
     0.879 -> 0.853).  A repair still at or above √3/2 with at most
     ``FEW_BAD`` triangles above its margin gets the angles at its fixed
-    samples split (:func:`samplers.repair.split_corners`; star prism's
+    samples split (:func:`sr33.samplers.repair.split_corners`; star prism's
     reflex corners: 0.938 -> 0.850, none of its samples violating III-ii
     any more; a pyramid 0.8 high on its unit base, with over 50 on each
     face, is left as it is: each split runs a repair again).  Faces
@@ -543,8 +379,8 @@ def repair_planar_faces(
         arcs = _arcs(face, to2d, [(e, faces[fb], fb) for e, fb in nbrs[fi] if fb >= 0])
         if not arcs and row_dirs is None:
             continue
-        seg = _boundary_segments(face, to2d, h / 20)
-        raster = _Raster(seg, h / RASTER)
+        seg = boundary_segments(face, to2d, h / 20)
+        raster = Raster(seg, h / RASTER)
         lines = (
             _slanted_lines(occ, fi, face, to2d, row_dirs, s, raster, h, nbrs)
             if row_dirs is not None
@@ -557,7 +393,7 @@ def repair_planar_faces(
         uv = to2d(s.points[cand])
         # the face's samples: inside it, or on its boundary (the tessellation's
         # boundary is a polyline: arc samples sit a sagitta off it)
-        mine = raster(uv) | (_segment_distance(uv, seg, h / 100) < 0.1 * h)
+        mine = raster(uv) | (segment_distance(uv, seg, h / 100) < 0.1 * h)
         idx = cand[mine]
         uv = uv[mine]
         # a fixed order (by position) so that congruent faces get the same answer
@@ -625,8 +461,8 @@ def repair_planar_faces(
                     ang_rec = np.arctan2(*(rec - a.centre).T[::-1])
                     uv[cur[np.argsort(ang_cur)]] = rec[np.argsort(ang_rec)]
                     slide[cur] = False
-            sides = _arc_sides(arcs, raster, h)
-            clamps = ([_clamp(arcs, sides, h)] if arcs else []) + (
+            sides = arc_sides(arcs, raster, h)
+            clamps = ([arc_clamp(arcs, sides, h)] if arcs else []) + (
                 [_clamp_lines(lines, h)] if lines else []
             )
             args = dict(
@@ -732,17 +568,11 @@ def _follow_columns(s: Samples, shifts: dict[int, list], faces, tol: float) -> N
         s.points[sel] = q + move
 
 
-def _goes_round(face) -> bool:
-    """Whether a face of revolution goes all the way round its axis."""
-    umin, umax, _, _ = face._uvBounds()
-    return abs((umax - umin) - 2 * math.pi) <= 1e-9
-
-
 def _full_turns(occ, kind: str):
     """(index, face) of the faces of a surface type that go all the way round
     (a partial cylinder is a fillet: its smooth edges are not sampled)."""
     for fi, face in enumerate(occ.Faces()):
-        if face.geomType() == kind and _goes_round(face):
+        if face.geomType() == kind and goes_round(face):
             yield fi, face
 
 
@@ -802,20 +632,6 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
 def _corner_points(face, to2d) -> np.ndarray:
     pts = [v.toTuple() for v in face.Vertices()]
     return to2d(np.array(pts)) if pts else np.empty((0, 2))
-
-
-def _segment_distance(p: np.ndarray, seg: np.ndarray, step: float) -> np.ndarray:
-    """Distance from each point to the segments, within ``step`` (a resampling that fine)."""
-    a, b = seg[:, 0], seg[:, 1]
-    length = np.linalg.norm(b - a, axis=1)
-    counts = np.maximum(1, np.ceil(length / step).astype(np.int64))
-    which = np.repeat(np.arange(seg.shape[0]), counts + 1)
-    frac = (np.arange(which.size) - np.repeat(np.cumsum(counts + 1) - counts - 1, counts + 1)) / (
-        np.repeat(counts, counts + 1)
-    )
-    dense = a[which] + frac[:, None] * (b - a)[which]
-    d, _ = cKDTree(dense).query(p)
-    return d
 
 
 def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
@@ -1063,7 +879,7 @@ def _repair_developed(
     sides are glued: a sample at slant distance ``rho`` and angle ``ang``
     about the axis lies at polar coordinates ``(rho, ang sin(a))``, and its
     intrinsic Delaunay triangles are the sector's, across the glued sides
-    too (:func:`samplers.repair.repair` with ``turn``).  Samples within
+    too (:func:`sr33.samplers.repair.repair` with ``turn``).  Samples within
     ``MOVABLE`` t of a triangle that breaks Condition III-ii (where rings
     halve, or an odd ring ends its columns unevenly, or at the glued sides)
     may move; the rim and samples within ``APEX_KEEP`` t of the apex stay.
@@ -1103,8 +919,7 @@ def _repair_developed(
     pts = np.vstack(copies(allp, turn))
     tri = Delaunay(pts).simplices
     tri = tri[inside(pts[tri].mean(axis=1))]
-    side = np.sort(np.linalg.norm(pts[tri] - pts[np.roll(tri, 1, axis=1)], axis=2), axis=1)
-    broken = pts[tri[side[:, 1] >= broken_at * side[:, 2]]].mean(axis=1)
+    broken = pts[tri[triangle_ratios(pts, tri) >= broken_at]].mean(axis=1)
     near = np.zeros(n, dtype=bool)
     if broken.shape[0]:
         tree = cKDTree(broken)
@@ -1119,7 +934,7 @@ def _repair_developed(
         fixed_free,
         t,
         inside=inside,
-        clamp=_radial_clamp(0.0, slant - 0.25 * t),
+        clamp=radial_clamp(0.0, slant - 0.25 * t),
         turn=turn,
     )
     mine = out.origin < n  # not the rim nor the apex
@@ -1160,29 +975,6 @@ def _end_columns(ang: np.ndarray, scale: float, t: float) -> np.ndarray:
         else:
             since = 0.0
     return ang[keep]
-
-
-def _halving_count(x: float) -> int:
-    """The count of the form c 2^k (c = 3, 4 or 5) nearest ``x`` by ratio (the
-    smaller on ties).
-
-    A ring of equal gaps ends every other column (:func:`_end_columns`), so
-    that a widest ring of such a count halves exactly, ring after ring; the
-    ring round a pole then halves once more if it has over 5 columns, so
-    that the pole's triangles have a chord longer than their sides (6 or
-    more columns make them near equilateral, breaking Condition III-ii).
-    Counts of this form lie at most a third apart, so the widest ring's
-    gaps stay within 15% of h.  Measured on cone_tip: 3.3% of the samples
-    violating with ``round(2 pi r / h)`` columns, 2.3% with this count.
-    """
-    best = 3
-    for c in (3, 4, 5):
-        n = c
-        while n < 2 * max(x, 3.0):
-            if abs(math.log(n / max(x, 1e-12))) < abs(math.log(best / max(x, 1e-12))) - 1e-12:
-                best = n
-            n *= 2
-    return best
 
 
 POLE_REACH = 10  # rings nearer a smooth pole than this (times t) are repaired
@@ -1264,15 +1056,6 @@ def _repair_pole(ring, columns, faces, t: float, end: int):
     return inner, list(zip(r2.tolist(), a2.tolist())), row2.tolist(), report
 
 
-def _revolution_axis(face):
-    """(point, unit direction) of a cone's, cylinder's or sphere's axis
-    (a sphere's point is its centre)."""
-    g = face._geomAdaptor()
-    kind = {"CONE": "Cone", "CYLINDER": "Cylinder"}.get(face.geomType(), "Sphere")
-    pos = getattr(g, kind)().Position()
-    return np.array(pos.Location().Coord()), np.array(pos.Direction().Coord())
-
-
 def _meridian(face, o, axis, count: int = 2000):
     """The face's meridian at u = umin: parameters v and (axial, radial) coordinates."""
     umin, _, vmin, vmax = face._uvBounds()
@@ -1292,7 +1075,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     from pole to pole is cut into ``round(S / h)`` equal arc-length steps,
     every step a ring (a parallel); the widest ring gets evenly spaced
     columns about h apart (a count that halves down to 3 to 5 columns,
-    :func:`_halving_count`), and the rings towards either pole keep the
+    :func:`halving_count`), and the rings towards either pole keep the
     columns of the ring before them, ending crowded ones as on a cone
     (:func:`lattice_cone_faces`).  Samples on the axis (the apex, the
     poles) stay; every other sample of the body is replaced (the seam's
@@ -1302,12 +1085,12 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     faces = occ.Faces()
     if not faces or any(f.geomType() not in ("CONE", "SPHERE") for f in faces):
         return []
-    if not all(_goes_round(f) for f in faces):
+    if not all(goes_round(f) for f in faces):
         return []
     tol = 1e-7 * size
-    o, axis = _revolution_axis(faces[0])
+    o, axis = revolution_axis(faces[0])
     for f in faces[1:]:
-        p, d = _revolution_axis(f)
+        p, d = revolution_axis(f)
         off = p - o
         if abs(abs(d @ axis) - 1) > 1e-9 or np.linalg.norm(off - (off @ axis) * axis) > tol:
             return []
@@ -1339,9 +1122,9 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     ring = [at(j * t) for j in range(1, rows)]  # (face, axial, radial) per row 1 .. rows - 1
     radial = np.array([r for _, _, r in ring])
     widest = int(np.argmax(radial))
-    ex = _perpendicular(axis)
+    ex = perpendicular(axis)
     ey = np.cross(axis, ex)
-    m = _halving_count(2 * math.pi * radial[widest] / h)
+    m = halving_count(2 * math.pi * radial[widest] / h)
     columns = {widest: 2 * math.pi * np.arange(m) / m}
     for step in (-1, 1):
         ang = columns[widest]
@@ -1349,7 +1132,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         while 0 <= j < len(ring):
             ang = _end_columns(ang, radial[j], t)
             if (j == 0 or j == len(ring) - 1) and ang.size > 5:
-                ang = ang[::2]  # the ring round a pole: at most 5 columns (see _halving_count)
+                ang = ang[::2]  # the ring round a pole: at most 5 columns (see halving_count)
             columns[j] = ang
             j += step
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0

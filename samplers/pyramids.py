@@ -33,7 +33,7 @@ geometric mean is h); the sweep directions and the sampler's row ratio do
 not apply (the lattice's ratio is the face's ``1 / tan(beta)``).  Taller
 pyramids, and pyramids so flat that samples across a base edge would be
 closer than ``MIN_GAP`` h (the default's are c apart), keep the scan rows
-and their repair (:mod:`samplers.layers`).
+and their repair (:mod:`sr33.samplers.layers`).
 CadQuery is imported when the functions run.
 """
 
@@ -45,9 +45,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay
 
+from sr33.mesh import triangle_ratios
+
 from .adjacency import EdgeFaces
-from .layers import Samples
-from .repair import BAD, triangle_ratios
+from .faces import nearest_face
+from .repair import BAD
+from .samples import Samples
 
 MAX_RATIO = 0.83  # lateral cells of a larger ratio sin(beta): the pyramid keeps its scan rows
 TIE_SHIFT = 0.02  # samples next to a lateral edge step this far from it (times c)
@@ -168,8 +171,6 @@ def lattice_pyramid(occ, s: Samples, h: float, size: float) -> tuple[list[dict],
     every base row and every lateral row is a scan line.  Returns one
     report per face and the indices of the faces laid out.
     """
-    from .scanline import _nearest_face
-
     tol = 1e-7 * size
     pyr = find_pyramid(occ, tol)
     if pyr is None:
@@ -203,7 +204,7 @@ def lattice_pyramid(occ, s: Samples, h: float, size: float) -> tuple[list[dict],
 
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     pts: list[np.ndarray] = [apex[None]]
-    fid: list[int] = [_nearest_face(apex, faces)]
+    fid: list[int] = [nearest_face(apex, faces)]
     lid: list[int] = [-1]
     feat: list[bool] = [True]
     reports = []
@@ -217,7 +218,7 @@ def lattice_pyramid(occ, s: Samples, h: float, size: float) -> tuple[list[dict],
         on = rim & (np.abs(np.cross(base - a, b - a)).sum(axis=1) < tol * pyr.width)
         owner[on] = edge_face(a, b)
     corner = rim & ((i % n == 0) & (j % n == 0))
-    owner[corner] = [_nearest_face(q, faces) for q in base[corner]]
+    owner[corner] = [nearest_face(q, faces) for q in base[corner]]
     pts.append(base)
     fid += owner.tolist()
     lid += np.where(rim, -1, line + j).tolist()

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
-from validators.conditions import SQRT3_2
+from sr33.mesh import SQRT3_2, triangle_ratios
 
 TARGET = 0.78  # the descent pushes every ratio below this
 BAD = 0.83  # a triangle above this still needs work (margin below sqrt(3)/2)
@@ -75,14 +75,6 @@ class Repaired:
     origin: np.ndarray
     bad: int
     worst: float
-
-
-def triangle_ratios(pts: np.ndarray, tri: np.ndarray) -> np.ndarray:
-    """Per triangle, its second-longest edge over its longest (Condition
-    III-ii asks for less than √3/2)."""
-    p = pts[tri]
-    length = np.sort(np.linalg.norm(p - p[:, [1, 2, 0]], axis=2), axis=1)
-    return length[:, 1] / length[:, 2]
 
 
 def rotate(p: np.ndarray, angle) -> np.ndarray:

@@ -32,23 +32,23 @@ a CadQuery shape:
   within h of a sample (their ``line_id`` is -2);
 * a right square pyramid no taller than about 0.55 of its base is laid
   out as one lattice, its lateral rows on the base's columns and its
-  lateral edges the cells' diagonals (:mod:`samplers.pyramids`); a box
+  lateral edges the cells' diagonals (:mod:`sr33.samplers.pyramids`); a box
   with filleted vertical and top edges as lattices continued across the
   fillets' seams, its corner octants in latitude rows repaired on their
-  stereographic map (:mod:`samplers.fillets`);
+  stereographic map (:mod:`sr33.samplers.fillets`);
 * planar disks and annuli whose rims bound cones or cylinders are laid
   out in rings about their centre, halving their columns inwards
-  (:mod:`samplers.disks`);
+  (:mod:`sr33.samplers.disks`);
 * where rows meet a circular sharp edge (a hole, the cut of a scoop) the
   boundary layer of each other planar face is repaired until its
-  Delaunay triangles meet Condition III-ii (:mod:`samplers.layers`,
-  :mod:`samplers.repair`; a face left with a few triangles at or above
+  Delaunay triangles meet Condition III-ii (:mod:`sr33.samplers.layers`,
+  :mod:`sr33.samplers.repair`; a face left with a few triangles at or above
   √3/2 is repaired once more from that answer); full cylinders are then
   laid out as the lattice their two rims span, and cones with a sampled
   rim in rings that keep the rim's columns and end crowded ones towards
   the apex; a partial sphere whose rims are all sharp (cutcube's scoop)
   takes rows h apart along its meridians and is repaired on its
-  stereographic map (:mod:`samplers.spheres`) (``repair=False`` keeps the
+  stereographic map (:mod:`sr33.samplers.spheres`) (``repair=False`` keeps the
   plain scan rows);
 * optional Gaussian jitter (σ·h) and dropout, both seeded.
 
@@ -67,16 +67,25 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
-from sr33._progress import bar, log, timed
+from sr33.mesh import surface_points
+from sr33.progress import bar, log, timed
 
 from .adjacency import EdgeFaces
+from .faces import (
+    exact_bounds,
+    goes_round,
+    nearest_face,
+    perpendicular,
+    rims_sampled,
+    row_cosine,
+    thin,
+)
 
 AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 EDGE_STEP = 1.0  # spacing of corner/edge samples, times h
 FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times h
 FILL_RADIUS = 1.0  # gaps wider than this (times h) get extra samples
 SLANT_STEP = 1.45  # slanted edges are sampled where rows cross them this close (times h)
-RIM_SAMPLED = 0.75  # an edge is sampled when a feature sample is this near its middle (times h)
 RATIO_RANGE = (0.6, 1.7)  # inside (1/sqrt(3), sqrt(3)) = (0.577, 1.732) with margin
 
 
@@ -113,7 +122,7 @@ class ScanSamples:
 
 
 def _occ(shape):
-    """The CadQuery shape inside a :class:`samplers.shapes.Shape` or the object itself."""
+    """The CadQuery shape inside a :class:`sr33.samplers.shapes.Shape` or the object itself."""
     # a samplers Shape record carries the CAD object in .solid (CadQuery's own
     # shapes have a .solid() method, hence the check on .expected)
     solid = shape.solid if hasattr(shape, "expected") else shape
@@ -156,18 +165,6 @@ def _check_args(spacing, target_points, ratio, jitter, dropout, seed, directions
     if not np.all(np.isfinite(norms)) or np.any(norms == 0):
         raise SamplingError("directions must be finite, non-zero vectors")
     return dirs / norms[:, None]
-
-
-def _exact_bounds(shape) -> tuple[np.ndarray, np.ndarray]:
-    """Bounding box from the exact geometry (CadQuery's uses any cached
-    triangulation, which would make the scan planes depend on history)."""
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
-
-    box = Bnd_Box()
-    BRepBndLib.AddOptimal_s(shape.wrapped, box, False, False)
-    xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
-    return np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
 
 
 def _box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -379,26 +376,12 @@ def _sphere_frame(face, d: np.ndarray):
     """(centre, radius, e1, e2, d) of a sphere face that does not go all the
     way round, with e1, e2 completing the scan direction ``d`` to a frame;
     None for any other face."""
-    from .layers import _goes_round, _perpendicular
-
-    if face.geomType() != "SPHERE" or _goes_round(face):
+    if face.geomType() != "SPHERE" or goes_round(face):
         return None
     sph = face._geomAdaptor().Sphere()
     centre = np.array(sph.Location().Coord())
-    e1 = _perpendicular(d)
+    e1 = perpendicular(d)
     return centre, float(sph.Radius()), e1, np.cross(d, e1), d
-
-
-def rims_sampled(face, feature: np.ndarray, h: float) -> bool:
-    """Whether every edge of the face carries feature samples (a sharp rim):
-    one lies within ``RIM_SAMPLED`` h of the edge's middle."""
-    if feature.shape[0] == 0:
-        return False
-    mids = np.array([e.positionAt(0.5).toTuple() for e in face.Edges()])
-    if mids.shape[0] == 0:
-        return False
-    gap, _ = cKDTree(feature).query(mids)
-    return bool(gap.max() <= RIM_SAMPLED * h)
 
 
 def _sphere_row(chain, step: float, sphere) -> np.ndarray:
@@ -516,15 +499,6 @@ def _columns(face, d, hf, ratio, anchor, axis_steps):
     return rows, float(anchor @ rows), ratio * hf
 
 
-def row_cosine(face, row_dir, u: np.ndarray) -> float | None:
-    """|cos| of the angle between the direction ``u`` (in the plane of
-    ``face``) and the face's scan rows (those of the planes with normal
-    ``row_dir``); None where the planes run along the face (no rows)."""
-    rows = np.cross(np.array(face.normalAt().toTuple()), row_dir)
-    n = float(np.linalg.norm(rows))
-    return None if n < 1e-9 else abs(float(u @ rows)) / n
-
-
 def _row_crossings(a, u, length, adjacent, faces, planes, step):
     """Where the lattice lines of an adjacent planar face (``adjacent``:
     indices into ``faces``) cross a straight edge slanted to that face's
@@ -626,49 +600,10 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
         dense += [edge.positionAt(j / md, mode="length").toTuple() for j in range(md + 1)]
     for p in vertex_pts:
         pts.append(p)
-        fid.append(_nearest_face(p, faces))
+        fid.append(nearest_face(p, faces))
     pts += edge_pts
     fid += edge_fid
     return pts, fid, np.array(dense, dtype=np.float64).reshape(-1, 3), lattices
-
-
-def _nearest_face(p, faces) -> int:
-    import cadquery as cq
-
-    v = cq.Vertex.makeVertex(*p)
-    d = [v.distance(f) for f in faces]
-    return int(np.argmin(d))
-
-
-def _thin(points: np.ndarray, radius: float) -> np.ndarray:
-    """Indices kept by a greedy pass in order: drop points within radius of a kept one."""
-    cell = radius
-    grid: dict[tuple[int, int, int], list[int]] = {}
-    keep: list[int] = []
-    r2 = radius * radius
-    keys = np.floor(points / cell).astype(np.int64)
-    for i in range(points.shape[0]):
-        kx, ky, kz = keys[i]
-        p = points[i]
-        ok = True
-        for dx in (-1, 0, 1):
-            for dy in (-1, 0, 1):
-                for dz in (-1, 0, 1):
-                    for j in grid.get((kx + dx, ky + dy, kz + dz), ()):
-                        q = points[j]
-                        if (p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 + (p[2] - q[2]) ** 2 < r2:
-                            ok = False
-                            break
-                    if not ok:
-                        break
-                if not ok:
-                    break
-            if not ok:
-                break
-        if ok:
-            keep.append(i)
-            grid.setdefault((int(kx), int(ky), int(kz)), []).append(i)
-    return np.array(keep, dtype=np.int64)
 
 
 def _fill_gaps(occ, faces, points: np.ndarray, h: float, size: float) -> np.ndarray:
@@ -684,7 +619,6 @@ def _fill_gaps(occ, faces, points: np.ndarray, h: float, size: float) -> np.ndar
     import cadquery as cq
     from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 
-    from validators.fidelity import surface_points
 
     tv, tt = occ.tessellate(size / 500.0, 0.1)
     if not tt:
@@ -753,7 +687,7 @@ def scan(
         explicitly (as are boundary edges and corners).
     repair : bool
         Lay disks out in rings and repair the boundary layers where rows
-        meet circular edges (:mod:`samplers.disks`, :mod:`samplers.layers`),
+        meet circular edges (:mod:`sr33.samplers.disks`, :mod:`sr33.samplers.layers`),
         so that Condition III-ii holds there too.
     quiet : bool
         No progress bar (one step per face's scan rows, then one per repair
@@ -770,7 +704,7 @@ def scan(
     if not faces:
         raise SamplingError("shape has no faces to sample")
     with bar(len(faces) + 2 + (8 if repair else 0), "sample", quiet, unit="step") as pbar:
-        lo, hi = _exact_bounds(occ)
+        lo, hi = exact_bounds(occ)
         size = float(np.linalg.norm(hi - lo))
         area = float(sum(f.Area() for f in faces))
         if spacing is not None:
@@ -812,7 +746,7 @@ def scan(
             pbar.update(1)
             d, t0, hf, _ = planes[fi]
             sphere = _sphere_frame(face, d)
-            proj = _box_corners(*_exact_bounds(face)) @ d
+            proj = _box_corners(*exact_bounds(face)) @ d
             rimmed = sphere is not None and rims_sampled(face, feature_pts, h)
             for t in _plane_offsets(proj.min(), proj.max(), t0, hf, sphere if rimmed else None):
                 origin = d * t
@@ -839,7 +773,7 @@ def scan(
         alive = np.flatnonzero(
             _drop_near_features(allp, on_line, feature_curve, FEATURE_CLEARANCE * h)
         )
-        keep = alive[_thin(allp[alive], 0.5 * min(1.0, ratio) * h)]
+        keep = alive[thin(allp[alive], 0.5 * min(1.0, ratio) * h)]
         points = allp[keep]
         line_id = np.array(line_ids, dtype=np.int64)[keep]
         face_id = np.array(fids, dtype=np.int64)[keep]
@@ -850,7 +784,7 @@ def scan(
         if fill.shape[0]:
             points = np.vstack([points, fill])
             line_id = np.r_[line_id, np.full(fill.shape[0], -2, dtype=np.int64)]
-            face_id = np.r_[face_id, [_nearest_face(q, faces) for q in fill]].astype(np.int64)
+            face_id = np.r_[face_id, [nearest_face(q, faces) for q in fill]].astype(np.int64)
             on_feature = np.r_[on_feature, np.zeros(fill.shape[0], dtype=bool)]
         reports: list[dict] = []
         if repair:

@@ -23,7 +23,7 @@ this module needs numpy alone.
 
 Examples
 --------
->>> from samplers.shapes import describe, shape_parameters
+>>> from sr33.samplers.shapes import describe, shape_parameters
 >>> shape_parameters("cube")
 {'side': 1.0}
 >>> describe("cube")
@@ -38,6 +38,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from sr33.mesh import edge_uses, half_edges, unique_rows
 
 MESH_TOLERANCE = 1.0 / 500.0  # linear deflection of the truth mesh, times the size
 MESH_ANGULAR = 0.1  # angular deflection of the truth mesh, radians
@@ -850,11 +852,10 @@ def _truth_mesh(solid, size: float) -> tuple[np.ndarray, np.ndarray]:
 
 def _mesh_problem(tri: np.ndarray, expected: Topology) -> str | None:
     """Why the truth mesh does not fit ``expected``, or None."""
-    e = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
-    _, dcount = np.unique(e, axis=0, return_counts=True)
-    if np.any(dcount > 1):
+    directed = half_edges(tri)[0]
+    if unique_rows(directed).shape[0] < directed.shape[0]:
         return "an edge is used twice in the same direction"
-    _, counts = np.unique(np.sort(e, axis=1), axis=0, return_counts=True)
+    _, counts = edge_uses(tri)
     if np.any(counts > 2):
         return f"{int(np.sum(counts > 2))} edges are used by more than two triangles"
     if expected.boundary_loops == 0 and np.any(counts == 1):

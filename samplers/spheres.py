@@ -2,7 +2,7 @@
 
 A partial sphere (cutcube's scoop) keeps its scan rows: sections by the
 family's planes, their columns at multiples of one angle that doubles where
-a row's gaps would fall below 0.75 h (:func:`samplers.scanline._sphere_row`).
+a row's gaps would fall below 0.75 h (:func:`sr33.samplers.scanline._sphere_row`).
 Where the columns halve, and where the rows end on the sphere's sharp rims
 at arbitrary places, Delaunay triangles break Condition III-ii.
 :func:`repair_sphere_faces` maps each such face onto the plane by the
@@ -10,9 +10,9 @@ stereographic projection from the point opposite the face's centre.  The
 map is conformal, so a triangle's ratio of Condition III-ii is kept up to
 the change of scale across it (at most 10% over the whole face when the
 face lies within 37° of its centre), and it maps circles to circles: the
-rims stay circular arcs, along which :func:`samplers.layers._clamp` keeps
+rims stay circular arcs, along which :func:`sr33.samplers.layers.arc_clamp` keeps
 the free samples on the face.  There the face is repaired like a planar
-one (:func:`samplers.repair.repair`): the rims' samples fixed, every other
+one (:func:`sr33.samplers.repair.repair`): the rims' samples fixed, every other
 sample of the face free.
 
 CadQuery and OCP are imported when the functions run.
@@ -24,23 +24,13 @@ import math
 
 import numpy as np
 
-from validators.conditions import SQRT3_2
+from sr33.mesh import SQRT3_2
 
-from .layers import (
-    FEW_BAD,
-    RASTER,
-    Samples,
-    _Arc,
-    _arc_sides,
-    _boundary_segments,
-    _clamp,
-    _goes_round,
-    _perpendicular,
-    _Raster,
-    _segment_distance,
-)
+from .chart import Arc, Raster, arc_clamp, arc_sides, segment_distance
+from .faces import boundary_segments, goes_round, perpendicular, rims_sampled
+from .layers import FEW_BAD, RASTER
 from .repair import repair, split_corners
-from .scanline import rims_sampled
+from .samples import Samples
 
 FRAME_REACH = 2.5  # the neighbours' samples this near a rim (times h) frame the repair
 FACING = 0.2  # the face lies where the direction from the centre has cos > this with the pole
@@ -53,7 +43,7 @@ class _Stereographic:
 
     def __init__(self, centre: np.ndarray, radius: float, pole: np.ndarray):
         self.centre, self.radius, self.pole = centre, radius, pole
-        self.e1 = _perpendicular(pole)
+        self.e1 = perpendicular(pole)
         self.e2 = np.cross(pole, self.e1)
 
     def __call__(self, p) -> np.ndarray:
@@ -84,7 +74,7 @@ def _circle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, fl
     return centre, float(np.linalg.norm(a - centre))
 
 
-def _rim_arcs(face, to2d) -> list[_Arc] | None:
+def _rim_arcs(face, to2d) -> list[Arc] | None:
     """The face's rims as arcs of the map (None when one is not a circle
     there: a rim through the projection's point, or an edge that is no
     circle)."""
@@ -97,13 +87,13 @@ def _rim_arcs(face, to2d) -> list[_Arc] | None:
             fit = _circle(*pts)
             if fit is None:
                 return None
-            out.append(_Arc(fit[0], fit[1], 0.0, 2 * math.pi, True, False))
+            out.append(Arc(fit[0], fit[1], 0.0, 2 * math.pi, True, False))
             continue
         s, m, f = to2d(np.array([e.positionAt(x).toTuple() for x in (0.0, 0.5, 1.0)]))
         fit = _circle(s, m, f)
         if fit is None:
             return None
-        out.append(_Arc.through(*fit, s, m, f))
+        out.append(Arc.through(*fit, s, m, f))
     return out
 
 
@@ -174,14 +164,14 @@ def repair_sphere_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     fillet_box went from 2.1% to 0.4% of its samples violating III-ii (the
     rest across the seams); laid out with the rest of its box, whose
     lattices meet the seams square, it is repaired by
-    :func:`samplers.fillets.lattice_filleted_box`.  So is a face reaching
+    :func:`sr33.samplers.fillets.lattice_filleted_box`.  So is a face reaching
     more than about 78° (``FACING``) from its centre, where the map would
     stretch too much.
     """
     reports = []
     feature = s.points[s.on_feature]
     for fi, face in enumerate(occ.Faces()):
-        if face.geomType() != "SPHERE" or _goes_round(face):
+        if face.geomType() != "SPHERE" or goes_round(face):
             continue
         if not rims_sampled(face, feature, h):
             continue
@@ -220,20 +210,20 @@ def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=N
     dist = np.linalg.norm(q, axis=1)
     cand = np.flatnonzero((np.abs(dist - radius) < tol) & (q @ pole > FACING * radius))
     uv = to2d(s.points[cand])
-    seg = _boundary_segments(face, to2d, h / 20)
-    raster = _Raster(seg, h / RASTER)
-    mine = raster(uv) | (_segment_distance(uv, seg, h / 100) < 0.1 * h)
+    seg = boundary_segments(face, to2d, h / 20)
+    raster = Raster(seg, h / RASTER)
+    mine = raster(uv) | (segment_distance(uv, seg, h / 100) < 0.1 * h)
     idx, uv = cand[mine], uv[mine]
     order = np.lexsort((np.round(uv[:, 1] / h, 6), np.round(uv[:, 0] / h, 6)))
     idx, uv = idx[order], uv[order]
     free = ~fixed[idx]
     if not free.any():
         return None
-    sides = _arc_sides(arcs, raster, h)
+    sides = arc_sides(arcs, raster, h)
     own = np.zeros(s.points.shape[0], dtype=bool)
     own[idx] = True
     frame = _rim_frame(face, arcs, sides, to2d, s, own, h)
-    args = dict(inside=raster, clamp=_clamp(arcs, sides, h), frame=frame, judge_frame=True)
+    args = dict(inside=raster, clamp=arc_clamp(arcs, sides, h), frame=frame, judge_frame=True)
     r = repair(uv, free, h, **args)
     if r.worst >= SQRT3_2 and r.bad <= FEW_BAD:
         r = split_corners(uv, free, h, r, **args)

@@ -8,7 +8,10 @@ The steps of Algorithm 1 of the paper, each usable alone:
 - :func:`triangulate` (Algorithm 1, line 4)
 - :func:`attach_cones` (cones for stray samples, end of Section 5)
 
-and :func:`reconstruct`, which chains them.
+and :func:`reconstruct`, which chains them.  The folders beside this one
+install as its subpackages: :mod:`sr33.validators` (judges of any mesh),
+:mod:`sr33.samplers` (CAD shapes and their samplings) and :mod:`sr33.gui`
+(the inspector).
 """
 
 from ._validate import InputError

@@ -56,10 +56,11 @@ from scipy import sparse
 from scipy.sparse import csgraph
 
 from . import _kernels
-from ._progress import bar
 from ._validate import InputError, as_edges, as_points
 from .cycles import CycleSet
 from .graph import cycle_edges, lookup_edges
+from .mesh import self_intersections, unique_edges, unique_rows
+from .progress import bar
 from .rng import Neighbourhoods, k_neighbourhoods
 from .tolerance import DEFAULT, Tolerance
 
@@ -194,18 +195,16 @@ def _fold_pairs(points, edges, inc_edge, inc_cycle, centroid, fold_degrees):
     out = np.concatenate(pairs).astype(np.int64)
     if not out.shape[0]:
         return np.empty((0, 2), dtype=np.int64)
-    return np.unique(np.sort(out, axis=1), axis=0)
+    return unique_edges(out)
 
 
 def _crossing_pairs(points, cs: CycleSet, centroid, free) -> np.ndarray:
     """Pairs (free cycle, any cycle near it) whose centroid fans intersect.
 
     Each cycle is fanned from its centroid; triangle pairs are tested exactly
-    (``validators.intersections``).  Only cycles that are free, or share a
+    (:func:`sr33.mesh.self_intersections`).  Only cycles that are free, or share a
     vertex with a free cycle, take part, so the cost follows the ambiguity.
     """
-    from validators.intersections import self_intersections
-
     idx = np.flatnonzero(free)
     if idx.shape[0] == 0:
         return np.empty((0, 2), dtype=np.int64)
@@ -245,7 +244,7 @@ def _crossing_pairs(points, cs: CycleSet, centroid, free) -> np.ndarray:
     a, b = own[hits[:, 0]], own[hits[:, 1]]
     keep = (a != b) & (free[a] | free[b])
     pairs = np.sort(np.stack([a[keep], b[keep]], axis=1), axis=1)
-    return np.unique(pairs, axis=0) if pairs.shape[0] else pairs
+    return unique_rows(pairs) if pairs.shape[0] else pairs
 
 
 def links_are_disks(n: int, vertex, prev, nxt) -> np.ndarray:
@@ -647,7 +646,7 @@ def backtracking(
     pts = as_points(points)
     n = pts.shape[0]
     e = as_edges(edges, n)
-    e = np.unique(np.sort(e, axis=1), axis=0) if e.shape[0] else e
+    e = unique_edges(e) if e.shape[0] else e
     if not isinstance(budget, (int, np.integer)) or budget < 1:
         raise InputError(f"budget must be a positive integer, got {budget!r}")
     nc = len(cycles)

@@ -34,7 +34,7 @@ def _stats_rows(stats) -> list[tuple[str, str]]:
 
 
 def _cmd_reconstruct(args) -> int:
-    from validators.topology import mesh_stats
+    from sr33.validators.topology import mesh_stats
 
     from .io import read_points, write_mesh, write_text
     from .reconstruct import reconstruct
@@ -82,7 +82,7 @@ def _cmd_reconstruct(args) -> int:
 
 
 def _cmd_stats(args) -> int:
-    from validators.topology import mesh_stats
+    from sr33.validators.topology import mesh_stats
 
     from .io import read_mesh
 
@@ -108,7 +108,7 @@ def _parse_params(items: list[str]) -> dict[str, float]:
 
 def _cmd_sample(args) -> int:
     try:
-        from samplers import scanline, shapes
+        from sr33.samplers import scanline, shapes
     except ImportError as exc:  # pragma: no cover - depends on the install
         raise InputError(f"sampling needs CadQuery: pip install cadquery ({exc})") from None
 
@@ -174,9 +174,9 @@ def _cmd_validate(args) -> int:
     import numpy as np
     from scipy.spatial import cKDTree
 
-    from validators.intersections import self_intersections
-    from validators.signature import homeomorphic, signature
-    from validators.topology import mesh_stats
+    from sr33.validators.intersections import self_intersections
+    from sr33.validators.signature import homeomorphic, signature
+    from sr33.validators.topology import mesh_stats
 
     from .io import read_mesh, read_points
 
@@ -204,7 +204,7 @@ def _cmd_validate(args) -> int:
         doc["points_not_vertices"] = missing
     ok = sig.manifold and sig.orientable and crossing.shape[0] == 0 and stats.overloaded_edges == 0
     if args.truth:
-        from validators.fidelity import hausdorff
+        from sr33.validators.fidelity import hausdorff
 
         tv, tf = read_mesh(args.truth)
         verdict = homeomorphic(sig, signature(tf, tv.shape[0], points=tv))
@@ -233,7 +233,7 @@ def _cmd_validate(args) -> int:
 
 
 def _cmd_conditions(args) -> int:
-    from validators.conditions import sample_conditions
+    from sr33.validators.conditions import sample_conditions
 
     from .io import read_mesh, read_points
 
@@ -253,7 +253,7 @@ def _cmd_conditions(args) -> int:
 
 
 def _cmd_view(args) -> int:
-    from gui._pv import has_display, pyvista
+    from sr33.gui import has_display, pyvista
 
     from .io import load_reconstruction, read_mesh
 
@@ -263,7 +263,7 @@ def _cmd_view(args) -> int:
             "--screenshot out.png (sr33 view INPUT --screenshot out.png)"
         )
     pv = pyvista(off_screen=bool(args.screenshot))
-    from gui import Inspector
+    from sr33.gui import Inspector
 
     path = Path(args.input)
     rec = None
@@ -295,9 +295,9 @@ def _cmd_view(args) -> int:
     for layer in args.hide or []:
         ins.set_layer(layer, False)
     if args.screenshot:
-        from .io import _atomic
+        from .io import atomic_output
 
-        with _atomic(args.screenshot, (".png",), "screenshot") as (tmp, _):
+        with atomic_output(args.screenshot, (".png",), "screenshot") as (tmp, _):
             ins.screenshot(tmp)
         print(f"screenshot written to {args.screenshot}")
         return 0

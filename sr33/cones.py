@@ -14,37 +14,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ._validate import InputError, as_points
-
-
-def _closest_on_triangle(p, a, b, c):
-    """Distance from p to triangle abc (Ericson, Real-Time Collision Detection 5.1.5)."""
-    ab, ac, ap = b - a, c - a, p - a
-    d1, d2 = ab @ ap, ac @ ap
-    if d1 <= 0 and d2 <= 0:
-        return np.linalg.norm(p - a)
-    bp = p - b
-    d3, d4 = ab @ bp, ac @ bp
-    if d3 >= 0 and d4 <= d3:
-        return np.linalg.norm(p - b)
-    vc = d1 * d4 - d3 * d2
-    if vc <= 0 and d1 >= 0 and d3 <= 0:
-        v = d1 / (d1 - d3)
-        return np.linalg.norm(p - (a + v * ab))
-    cp = p - c
-    d5, d6 = ab @ cp, ac @ cp
-    if d6 >= 0 and d5 <= d6:
-        return np.linalg.norm(p - c)
-    vb = d5 * d2 - d1 * d6
-    if vb <= 0 and d2 >= 0 and d6 <= 0:
-        w = d2 / (d2 - d6)
-        return np.linalg.norm(p - (a + w * ac))
-    va = d3 * d6 - d5 * d4
-    if va <= 0 and (d4 - d3) >= 0 and (d5 - d6) >= 0:
-        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
-        return np.linalg.norm(p - (b + w * (c - b)))
-    denom = 1.0 / (va + vb + vc)
-    v, w = vb * denom, vc * denom
-    return np.linalg.norm(p - (a + ab * v + ac * w))
+from .mesh import closest_points_on_triangles
 
 
 def ring_centres(points, faces) -> dict[int, int]:
@@ -147,12 +117,11 @@ def attach_cones(points, triangles, *, candidates: int = 16) -> tuple[np.ndarray
         kq = min(candidates, len(live))
         _, near = tree.query(pts[p], kq)
         near = np.atleast_1d(near)
-        best, best_d = -1, np.inf
-        for j in near.tolist():
-            t = tris[live[j]]
-            d = _closest_on_triangle(pts[p], pts[t[0]], pts[t[1]], pts[t[2]])
-            if d < best_d or (d == best_d and live[j] < best):
-                best, best_d = live[j], d
+        cand = np.array([live[j] for j in near.tolist()], dtype=np.int64)
+        d2, _ = closest_points_on_triangles(
+            np.repeat(pts[p][None], cand.size, axis=0), pts[np.array([tris[i] for i in cand])]
+        )
+        best = int(cand[np.lexsort((cand, d2))[0]])  # nearest; ties: the earliest triangle
         a, b, c = tris[best]
         alive[best] = False
         for new in ((a, b, p), (b, c, p), (c, a, p)):

@@ -21,6 +21,7 @@ import numpy as np
 from . import _kernels
 from ._validate import InputError, as_edges, check_max_cycle_length
 from .graph import adjacency
+from .mesh import unique_edges
 
 
 @dataclass(frozen=True)
@@ -96,7 +97,7 @@ def trivial_isometric_cycles(edges, n_points: int, *, max_length: int = 8) -> Cy
     e = as_edges(edges, int(n_points))
     max_length = check_max_cycle_length(max_length)
     if e.shape[0]:
-        e = np.unique(np.sort(e, axis=1), axis=0)
+        e = unique_edges(e)
     indptr, indices = adjacency(e, int(n_points))
     offsets, verts = _kernels.isometric_cycles(indptr, indices, max_length)
     cs = CycleSet(offsets=offsets, vertices=verts)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
+from .mesh import edge_keys
+
 
 def adjacency(edges: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Symmetric CSR adjacency ``(indptr, indices)`` with sorted rows."""
@@ -15,13 +17,6 @@ def adjacency(edges: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     a = sparse.csr_matrix((data, (rows, cols)), shape=(n, n))
     a.sort_indices()
     return a.indptr.astype(np.int64), a.indices.astype(np.int64)
-
-
-def edge_keys(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
-    """Order-free integer key of the undirected edges (a, b)."""
-    lo = np.minimum(a, b).astype(np.int64)
-    hi = np.maximum(a, b).astype(np.int64)
-    return lo * n + hi
 
 
 def cycle_edges(offsets: np.ndarray, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -164,7 +164,7 @@ def _read_vtp(p: Path):
 
 
 @contextmanager
-def _atomic(path, formats: tuple[str, ...], what: str) -> Iterator[tuple[str, str]]:
+def atomic_output(path, formats: tuple[str, ...], what: str) -> Iterator[tuple[str, str]]:
     """Yield ``(temporary path, extension)`` in the target's directory; on
     success rename it over ``path``, on any failure remove it."""
     p = Path(path)
@@ -216,7 +216,7 @@ def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
     """
     v = np.ascontiguousarray(vertices, dtype=np.float64)
     t = np.ascontiguousarray(triangles, dtype=np.int64)
-    with _atomic(path, MESH_FORMATS, "output") as (tmp, ext):
+    with atomic_output(path, MESH_FORMATS, "output") as (tmp, ext):
         if ext == ".vtp":
             faces = np.hstack([np.full((t.shape[0], 1), 3, dtype=np.int64), t]).ravel()
             _pyvista(path).PolyData(v, faces).save(tmp, binary=True)
@@ -247,7 +247,8 @@ def write_points(path, points: np.ndarray, fields: dict[str, np.ndarray] | None 
     """
     v = np.ascontiguousarray(points, dtype=np.float64)
     fields = {k: np.asarray(a, dtype=np.int32) for k, a in (fields or {}).items()}
-    with _atomic(path, (".ply", ".xyz", ".txt", ".npy", ".obj", ".vtp"), "point") as (tmp, ext):
+    formats = (".ply", ".xyz", ".txt", ".npy", ".obj", ".vtp")
+    with atomic_output(path, formats, "point") as (tmp, ext):
         if ext == ".ply":
             _write_ply(tmp, v, None, fields)
         elif ext in (".xyz", ".txt"):
@@ -269,7 +270,7 @@ def write_points(path, points: np.ndarray, fields: dict[str, np.ndarray] | None 
 
 def write_text(path, text: str) -> Path:
     """Write a JSON or text file atomically."""
-    with _atomic(path, (".json", ".txt"), "text") as (tmp, _):
+    with atomic_output(path, (".json", ".txt"), "text") as (tmp, _):
         with open(tmp, "w", encoding="utf-8") as fh:
             fh.write(text)
     return Path(path)
@@ -339,7 +340,7 @@ def save_reconstruction(path, rec) -> Path:
         "timing_names": np.array(list(rec.timings), dtype=str),
         "timing_values": np.array(list(rec.timings.values()), dtype=np.float64),
     }
-    with _atomic(path, (".npz",), "reconstruction") as (tmp, _):
+    with atomic_output(path, (".npz",), "reconstruction") as (tmp, _):
         with open(tmp, "wb") as fh:
             np.savez(fh, sr33_reconstruction=np.array(1), **arrays)
     return Path(path)

@@ -12,11 +12,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._progress import log, timed
 from ._validate import as_points, check_k, check_max_cycle_length, check_not_degenerate
 from .backtracking import backtracking
 from .cones import attach_cones, ring_centres
 from .cycles import CycleSet, trivial_isometric_cycles
+from .progress import log, timed
 from .rng import localized_rng
 from .selfcheck import check_faces_and_triangles, strict_default
 from .tolerance import DEFAULT, Tolerance

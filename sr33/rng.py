@@ -16,8 +16,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from . import _kernels
-from ._progress import bar, chunks
 from ._validate import as_points, check_k, check_not_degenerate, check_unique
+from .progress import bar, chunks
 from .tolerance import DEFAULT, Tolerance
 
 

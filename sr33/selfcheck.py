@@ -15,6 +15,7 @@ import numpy as np
 
 from .cycles import CycleSet
 from .graph import cycle_edges
+from .mesh import unique_edges
 
 
 class InternalError(RuntimeError):
@@ -24,11 +25,6 @@ class InternalError(RuntimeError):
 def strict_default() -> bool:
     """True when the environment variable ``SR33_STRICT`` is set to 1."""
     return os.environ.get("SR33_STRICT", "") == "1"
-
-
-def _uses(pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    e = np.sort(pairs, axis=1)
-    return np.unique(e, axis=0, return_counts=True)
 
 
 def check_faces_and_triangles(
@@ -44,7 +40,7 @@ def check_faces_and_triangles(
     if len(faces) == 0:
         return
     pairs, _ = cycle_edges(faces.offsets, faces.vertices)
-    fe, fc = _uses(pairs)
+    fe, fc = unique_edges(pairs, return_counts=True)
     if fc.max() > 2:
         raise InternalError(f"backtracking invariant broken: an edge is used {fc.max()} times")
     per_face = np.bincount(face_of_triangle, minlength=len(faces))
@@ -54,7 +50,7 @@ def check_faces_and_triangles(
     if not np.array_equal(per_face, want):
         raise InternalError("triangulate: a face did not become length - 2 triangles")
     tp = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
-    te, tc = _uses(tp)
+    te, tc = unique_edges(tp, return_counts=True)
     if tc.max() > 2:
         raise InternalError(f"triangulate: an edge is used by {tc.max()} triangles")
     v = np.unique(faces.vertices).shape[0]

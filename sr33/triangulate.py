@@ -25,7 +25,8 @@ from scipy.sparse import csgraph
 
 from ._validate import InputError, as_points
 from .cycles import CycleSet
-from .graph import cycle_edges, edge_keys
+from .graph import cycle_edges
+from .mesh import edge_incidence, edge_keys, orientation_double_cover
 
 
 @dataclass(frozen=True)
@@ -63,29 +64,17 @@ def orient_cycles(points: np.ndarray, faces: CycleSet) -> tuple[CycleSet, bool]:
     Faces sharing an edge used by exactly two faces are linked; on each
     component the faces are oriented like its canonically smallest face,
     read off the orientation double cover
-    (:func:`validators.signature.orientation_double_cover`); closed
+    (:func:`sr33.mesh.orientation_double_cover`); closed
     components are then flipped to enclose positive volume.  Returns the
     oriented cycles and whether every component was orientable.
     """
-    from validators.signature import orientation_double_cover
-
     n = points.shape[0]
     nf = len(faces)
     if nf == 0:
         return faces, True
     pairs, owner = cycle_edges(faces.offsets, faces.vertices)
-    keys = edge_keys(pairs[:, 0], pairs[:, 1], n)
-    forward = pairs[:, 0] < pairs[:, 1]
-    order = np.argsort(keys, kind="stable")
-    ks = keys[order]
-    same = np.flatnonzero(ks[1:] == ks[:-1])
     # only edges shared by exactly two faces link faces
-    _, inv, cnt = np.unique(ks, return_inverse=True, return_counts=True)
-    two = cnt[inv[same]] == 2
-    a = order[same[two]]
-    b = order[same[two] + 1]
-    fa, fb = owner[a], owner[b]
-    coherent = forward[a] != forward[b]
+    _, fa, fb, coherent = edge_incidence(pairs, owner, n).manifold_pairs()
     g = sparse.csr_matrix(
         (np.ones(fa.shape[0] * 2, dtype=np.int8), (np.r_[fa, fb], np.r_[fb, fa])), shape=(nf, nf)
     )

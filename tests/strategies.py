@@ -70,7 +70,7 @@ ACUTE_SHAPES = ("pyramid", "star_prism", "wedge")
 def shape_params(draw, name: str) -> dict[str, float]:
     """Parameters of a library shape: each default perturbed by up to 15%,
     times one overall scale in [0.5, 2]; angles moved by up to 10 degrees."""
-    from samplers import shapes
+    from sr33.samplers import shapes
 
     scale = draw(st.floats(0.5, 2.0))
     out = {}

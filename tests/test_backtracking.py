@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 from hypothesis import given
 
-from samplers import cube_lattice, grid_lattice
 from sr33 import InputError, backtracking, localized_rng, trivial_isometric_cycles
 from sr33.cycles import CycleSet
+from sr33.samplers import cube_lattice, grid_lattice
+from sr33.validators import edge_uses
 from tests.strategies import clouds
-from validators import edge_uses
 
 
 def select(points, nb_size, **kw):

@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from samplers import cube_lattice
 from sr33.cli import main
 from sr33.io import read_mesh, write_mesh
+from sr33.samplers import cube_lattice
 from tests.helpers import PAPER_SMALL, need
 
 

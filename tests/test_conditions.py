@@ -6,8 +6,8 @@ import pytest
 pv = pytest.importorskip("pyvista")
 pytest.importorskip("potpourri3d")
 
+from sr33.validators.conditions import local_delaunay, sample_conditions  # noqa: E402
 from tests.helpers import grid_edges  # noqa: E402
-from validators.conditions import local_delaunay, sample_conditions  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -123,7 +123,7 @@ def test_dt_m_of_a_flat_annulus_with_a_cad_truth_is_its_delaunay():
     (up to the choice of diagonal in a near-cocircular cell)."""
     from scipy.spatial import Delaunay
 
-    from samplers.disks import _layout
+    from sr33.samplers.disks import _layout
 
     m, r_in, r_out, h = 126, 0.3, 0.5, 0.02
     a = 2 * np.pi * np.arange(m) / m
@@ -195,7 +195,7 @@ def test_chords_stand_for_geodesics_only_where_the_patch_is_flat_between():
     each other: the chord through the solid is far shorter than the geodesic,
     and labelling by it had a designed apex's Voronoi cell lose its spokes.
     The chord serves only where the patch's normals at both ends agree."""
-    from validators.conditions import _chord_ok, _patch_sets
+    from sr33.validators.conditions import _chord_ok, _patch_sets
 
     m, rings = 64, 8  # an open cone: apex, then rings of m vertices
     a = 2 * np.pi * np.arange(m) / m
@@ -234,7 +234,7 @@ def test_edges_plainly_not_delaunay_are_flipped(height, crossings, flipped):
     flips it to (c, d) when the angles at c and d exceed π by more than
     FLIP_MARGIN (a labelling error where samples crowd, as round a cone's
     designed fan), or by anything on a near tie; a Delaunay edge stays."""
-    from validators.conditions import FLIP_MARGIN, _flip_to_delaunay
+    from sr33.validators.conditions import FLIP_MARGIN, _flip_to_delaunay
 
     assert FLIP_MARGIN == 5.0
     pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, height], [0.5, -height]])

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from sr33 import InputError, attach_cones
-from validators import mesh_stats
+from sr33.validators import mesh_stats
 
 TETRA = np.array([[0, 1, 2], [0, 3, 1], [1, 3, 2], [2, 3, 0]])
 TETRA_PTS = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)

@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from samplers import cube_lattice, grid_lattice
 from sr33 import InputError, localized_rng, trivial_isometric_cycles
+from sr33.samplers import cube_lattice, grid_lattice
 from tests.naive import naive_isometric_cycles
 from tests.strategies import clouds
 

@@ -5,7 +5,7 @@ import pytest
 
 pv = pytest.importorskip("pyvista")
 
-from validators.fidelity import feature_distance, hausdorff, sharp_edges  # noqa: E402
+from sr33.validators.fidelity import feature_distance, hausdorff, sharp_edges  # noqa: E402
 
 
 @pytest.fixture(scope="module")

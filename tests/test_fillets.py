@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from samplers import shapes
-from samplers.fillets import find_filleted_box
-from samplers.scanline import _occ, scan
+from sr33.samplers import shapes
+from sr33.samplers.fillets import find_filleted_box
+from sr33.samplers.scanline import _occ, scan
 
 
 @pytest.fixture(scope="module")
@@ -92,7 +92,8 @@ def test_the_bottoms_stuck_repair_runs_again(box):
     with two triangles of 0.884 where a corner's arc meets the rows, split
     in vain, and the second run from that answer leaves none above the
     margin (repair_planar_faces' ``again``)."""
-    from samplers.layers import Samples, repair_planar_faces
+    from sr33.samplers.layers import repair_planar_faces
+    from sr33.samplers.samples import Samples
 
     s, r = box
     bottom = [x for x in r.meta["repairs"] if x["kind"] == "plane"]

@@ -7,15 +7,15 @@ import pytest
 
 pytest.importorskip("pyvista")
 
-from gui._pv import pyvista  # noqa: E402
+from sr33.gui import pyvista  # noqa: E402
 
 pv = pyvista(off_screen=True)
 
-from gui import COLOURS, LAYERS, Inspector  # noqa: E402
-from samplers import cube_lattice  # noqa: E402
 from sr33 import Reconstruction, k_neighbourhoods, reconstruct  # noqa: E402
 from sr33.cli import main  # noqa: E402
+from sr33.gui import COLOURS, LAYERS, Inspector  # noqa: E402
 from sr33.io import load_reconstruction, read_points, save_reconstruction  # noqa: E402
+from sr33.samplers import cube_lattice  # noqa: E402
 from tests.helpers import PAPER_SMALL, need  # noqa: E402
 
 

@@ -2,10 +2,10 @@
 
 import numpy as np
 
-from samplers import cube_lattice
 from sr33 import reconstruct
+from sr33.samplers import cube_lattice
+from sr33.validators.intersections import self_intersections
 from tests.meshes import icosphere
-from validators.intersections import self_intersections
 
 
 def test_two_crossing_triangles_are_one_pair():

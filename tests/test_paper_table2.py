@@ -10,8 +10,8 @@ from scipy.spatial import cKDTree
 
 from sr33 import reconstruct
 from sr33.io import read_mesh, read_points
+from sr33.validators import mesh_stats
 from tests.helpers import MESHES, PAPER_LARGE, need
-from validators import mesh_stats
 
 TABLE2 = {
     # name: (open edges, Euler characteristic, boundary loops, total edges)

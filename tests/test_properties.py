@@ -21,9 +21,13 @@ from hypothesis import strategies as st
 
 pytest.importorskip("cadquery")
 
-from samplers import cube_lattice, shapes  # noqa: E402
-from samplers.scanline import scan  # noqa: E402
 from sr33 import InputError, Reconstruction, localized_rng, reconstruct  # noqa: E402
+from sr33.samplers import cube_lattice, shapes  # noqa: E402
+from sr33.samplers.scanline import scan  # noqa: E402
+from sr33.validators import mesh_stats  # noqa: E402
+from sr33.validators.fidelity import hausdorff  # noqa: E402
+from sr33.validators.intersections import self_intersections  # noqa: E402
+from sr33.validators.signature import homeomorphic, signature  # noqa: E402
 from tests.fuzzstats import count  # noqa: E402
 from tests.helpers import triangle_set  # noqa: E402
 from tests.strategies import (  # noqa: E402
@@ -33,10 +37,6 @@ from tests.strategies import (  # noqa: E402
     scan_settings,
     shape_params,
 )
-from validators import mesh_stats  # noqa: E402
-from validators.fidelity import hausdorff  # noqa: E402
-from validators.intersections import self_intersections  # noqa: E402
-from validators.signature import homeomorphic, signature  # noqa: E402
 
 DEEP = os.environ.get("HYPOTHESIS_PROFILE") == "deep"
 PER_SHAPE = 36 if DEEP else 2  # 14 shapes x 36 = 504 examples in the deep profile
@@ -164,8 +164,8 @@ def test_theorem_1_2_rng_equals_urquhart_on_smooth_patches(flat_truth, perturb, 
     # intrinsic Urquhart graph, Theorem 1) must equal the localized RNG
     # (Theorem 2), and both the grid; the RNG is also checked after a rigid
     # motion and scaling
+    from sr33.validators.conditions import sample_conditions
     from tests.helpers import grid_edges
-    from validators.conditions import sample_conditions
 
     count("theorem_1_2")
     n = 9

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from samplers import shapes
-from samplers.pyramids import MAX_RATIO, TIE_SHIFT, find_pyramid, pyramid_steps
-from samplers.scanline import _occ, scan
+from sr33.samplers import shapes
+from sr33.samplers.pyramids import MAX_RATIO, TIE_SHIFT, find_pyramid, pyramid_steps
+from sr33.samplers.scanline import _occ, scan
 
 
 @pytest.mark.parametrize("params", [{}, {"base": 2.0, "height": 0.7}])

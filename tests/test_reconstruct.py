@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from samplers import cube_lattice
 from sr33 import reconstruct
 from sr33.io import read_points
+from sr33.samplers import cube_lattice
+from sr33.validators import mesh_stats
 from tests.helpers import PAPER_SMALL, need, triangle_set
 from tests.strategies import rotation
-from validators import mesh_stats
 
 
 def figures(r):

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from validators import mesh_stats
-from validators.refine import insert_points, refine_to_edge_length
-from validators.topology import edge_uses
+from sr33.validators import mesh_stats
+from sr33.validators.refine import insert_points, refine_to_edge_length
+from sr33.validators.topology import edge_uses
 
 
 def octahedron():

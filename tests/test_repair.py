@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial import Delaunay, cKDTree
 
-from samplers.repair import BAD, repair, rotate, split_corners
+from sr33.samplers.repair import BAD, repair, rotate, split_corners
 
 
 def hole_layout(h, radius, centre):
@@ -82,7 +82,7 @@ def test_nothing_to_move_returns_the_input():
 def test_ring_of_equal_gaps_ends_every_other_column():
     import math
 
-    from samplers.layers import _end_columns
+    from sr33.samplers.layers import _end_columns
 
     ang = 2 * math.pi * np.arange(40) / 40
     scale = 0.76 * 40 / (2 * math.pi)  # gaps of 0.76 t: below END_GAP
@@ -93,9 +93,9 @@ def test_ring_of_equal_gaps_ends_every_other_column():
 
 
 def test_halving_counts_are_three_four_or_five_times_a_power_of_two():
-    from samplers.layers import _halving_count
+    from sr33.samplers.chart import halving_count
 
-    got = [_halving_count(x) for x in (1, 3, 4.4, 5.6, 7, 9, 11, 14, 25, 50, 100, 125, 170)]
+    got = [halving_count(x) for x in (1, 3, 4.4, 5.6, 7, 9, 11, 14, 25, 50, 100, 125, 170)]
     assert got == [3, 3, 4, 6, 8, 10, 12, 16, 24, 48, 96, 128, 160]
 
 
@@ -105,12 +105,12 @@ def test_free_samples_keep_half_h_from_a_cylinders_rim():
     ratio 0.99) is put back at h / 2; other arcs keep h / 4."""
     import math
 
-    from samplers.layers import _Arc, _clamp
+    from sr33.samplers.chart import Arc, arc_clamp
 
     h = 0.1
-    rim = _Arc(np.zeros(2), 1.0, 0.0, 2 * math.pi, True, True)
-    other = _Arc(np.array([5.0, 0.0]), 1.0, 0.0, 2 * math.pi, True, False)
-    clamp = _clamp([rim, other], [-1.0, -1.0], h)  # the face lies outside both circles
+    rim = Arc(np.zeros(2), 1.0, 0.0, 2 * math.pi, True, True)
+    other = Arc(np.array([5.0, 0.0]), 1.0, 0.0, 2 * math.pi, True, False)
+    clamp = arc_clamp([rim, other], [-1.0, -1.0], h)  # the face lies outside both circles
     p = np.array([[1.03, 0.0], [0.0, 1.2], [6.02, 0.0], [5.0, 1.3]])
     out = clamp(p)
     r = np.linalg.norm(out - [[0, 0], [0, 0], [5, 0], [5, 0]], axis=1)

@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from samplers import cube_lattice, grid_lattice
 from sr33 import DEFAULT, InputError, k_neighbourhoods, localized_rng
+from sr33.samplers import cube_lattice, grid_lattice
 from tests.helpers import grid_edges
 from tests.naive import naive_localized_rng, naive_neighbourhoods
 from tests.strategies import clouds

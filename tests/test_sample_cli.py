@@ -9,7 +9,7 @@ pytest.importorskip("cadquery")
 
 from sr33.cli import main  # noqa: E402
 from sr33.io import read_mesh, read_points  # noqa: E402
-from validators import mesh_stats  # noqa: E402
+from sr33.validators import mesh_stats  # noqa: E402
 
 
 def test_list_names_every_shape_with_parameters(capsys):
@@ -60,8 +60,8 @@ def test_sampling_logs_every_step_at_debug_level(caplog):
     import logging
     import re
 
-    from samplers import shapes
-    from samplers.scanline import scan
+    from sr33.samplers import shapes
+    from sr33.samplers.scanline import scan
 
     with caplog.at_level(logging.DEBUG, logger="sr33"):
         scan(shapes.build("cube"), 0.1)
@@ -107,8 +107,8 @@ def test_sampled_points_reconstruct_to_the_expected_topology(tmp_path, capsys):
 
 
 def test_no_repair_keeps_the_plain_scan_rows(tmp_path):
-    from samplers import shapes
-    from samplers.scanline import scan
+    from sr33.samplers import shapes
+    from sr33.samplers.scanline import scan
 
     out = tmp_path / "p.xyz"
     argv = ["sample", "cylinder", "--spacing", "0.1", "-o", str(out)]

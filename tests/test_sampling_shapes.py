@@ -7,10 +7,10 @@ pytest.importorskip("cadquery")
 
 from scipy.spatial import cKDTree  # noqa: E402
 
-from samplers import shapes  # noqa: E402
-from samplers.scanline import scan  # noqa: E402
-from validators import mesh_stats  # noqa: E402
-from validators.fidelity import surface_points  # noqa: E402
+from sr33.samplers import shapes  # noqa: E402
+from sr33.samplers.scanline import scan  # noqa: E402
+from sr33.validators import mesh_stats  # noqa: E402
+from sr33.validators.fidelity import surface_points  # noqa: E402
 
 NAMES = shapes.shape_names()
 
@@ -37,7 +37,7 @@ def tall_pyramid():
 def checked(sampled):
     """The geodesic sample-condition check of a shape's default samples, run once."""
     pytest.importorskip("potpourri3d")
-    from validators.conditions import sample_conditions
+    from sr33.validators.conditions import sample_conditions
 
     done = {}
 
@@ -310,7 +310,7 @@ def test_repaired_boundary_layer_cuts_condition_iii_violations(sampled):
     after the repair of the boundary layer for none (worst ratio 0.832),
     and III-i (degree <= 33) holds everywhere."""
     pytest.importorskip("potpourri3d")
-    from validators.conditions import sample_conditions
+    from sr33.validators.conditions import sample_conditions
 
     s, r = sampled["box_hole"]
     plain = scan(s, repair=False)
@@ -371,7 +371,7 @@ def test_revolved_body_is_laid_out_in_rings():
     repaired (below)."""
     import math
 
-    from samplers.layers import POLE_REACH
+    from sr33.samplers.layers import POLE_REACH
 
     s = shapes.build("cone_tip")
     r = scan(s)
@@ -397,7 +397,7 @@ def test_revolved_body_is_laid_out_in_rings():
     while c % 2 == 0 and c > 5:
         c //= 2
     assert c in (3, 4, 5)
-    from validators.fidelity import distance_to_surface
+    from sr33.validators.fidelity import distance_to_surface
 
     d = distance_to_surface(r.points, s.truth_vertices, s.truth_triangles)
     assert d.max() < 2e-3 * r.meta["spacing"] * 50  # on the surface, up to the truth's sagitta
@@ -407,7 +407,7 @@ def test_revolved_body_is_laid_out_in_rings():
     "radii, h", [((0.5,), 0.025), ((0.5,), 0.03), ((0.5, 0.3), 0.02), ((0.35, 0.05), 0.02)]
 )
 def test_ring_plan_halves_its_columns_towards_the_centre(radii, h):
-    from samplers.disks import HALVE_GAP, ring_plan
+    from sr33.samplers.disks import HALVE_GAP, ring_plan
 
     t, rings = ring_plan(radii, h)
     r = np.array([x for x, _ in rings])
@@ -451,7 +451,7 @@ def test_round_faces_are_rings_without_bad_triangles(sampled, name):
         side = np.sort(np.linalg.norm(uv[tri] - uv[np.roll(tri, 1, axis=1)], axis=2), axis=1)
         assert (side[:, 1] / side[:, 2]).max() < np.sqrt(3) / 2
     if name == "cylinder":
-        from samplers.disks import ring_plan
+        from sr33.samplers.disks import ring_plan
 
         walls = [x for x in r.meta["repairs"] if x["kind"] == "cylinder lattice"]
         rim_count = ring_plan((s.params["radius"],), r.meta["spacing"])[1][0][1]
@@ -510,7 +510,7 @@ def test_rings_round_a_pole_and_an_apex_are_repaired(sampled, checked):
     (nor any other: see test_shapes_meet_condition_iii)."""
     import math
 
-    from samplers.layers import POLE_REACH
+    from sr33.samplers.layers import POLE_REACH
 
     s, r = sampled["cone_tip"]
     reps = {x["kind"]: x for x in r.meta["repairs"] if x["kind"] in ("pole", "apex")}
@@ -553,7 +553,7 @@ def test_slanted_edge_layers_are_edited(sampled):
     with removals and insertions (at most 160 a face), and no triangle is
     left above the repair's margin (86 were, relaxing the layer alone with
     the edge samples fixed)."""
-    from samplers.layers import FOLLOW_EDITS
+    from sr33.samplers.layers import FOLLOW_EDITS
 
     _, r = sampled["wedge"]
     planes = [x for x in r.meta["repairs"] if x["kind"] == "plane"]
@@ -573,7 +573,7 @@ def test_edges_whose_samples_are_far_apart_stay():
     edges stay: their samples keep the crossings' lattice, and no sample
     breaks Condition III."""
     pytest.importorskip("potpourri3d")
-    from validators.conditions import sample_conditions
+    from sr33.validators.conditions import sample_conditions
 
     s = shapes.build("wedge", angle=90.0)
     r = scan(s)
@@ -604,7 +604,7 @@ def test_apex_fans_meet_condition_iii_with_their_spokes_delaunay():
     83° nor at 115° and 116°."""
     import math
 
-    from samplers.layers import FAN_ANGLES, FAN_CHORD, FAN_RATIO, _apex_fan, _fan_figures
+    from sr33.samplers.layers import FAN_ANGLES, FAN_CHORD, FAN_RATIO, _apex_fan, _fan_figures
 
     uneven = []
     for degrees in range(60, 361, 5):

@@ -7,8 +7,8 @@ cq = pytest.importorskip("cadquery")
 
 from scipy.spatial import cKDTree  # noqa: E402
 
-from samplers.scanline import SamplingError, scan  # noqa: E402
-from validators.conditions import local_delaunay  # noqa: E402
+from sr33.samplers.scanline import SamplingError, scan  # noqa: E402
+from sr33.validators.conditions import local_delaunay  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -136,7 +136,7 @@ def test_even_ends_split_a_wide_end_gap():
     columns taken from a slanted edge) drops positions nearer than the
     clearance to an end and splits an end gap wider than twice it: the
     reflex edge's neighbours stood 1.8 h off (ratio 0.875)."""
-    from samplers.scanline import _even_ends
+    from sr33.samplers.scanline import _even_ends
 
     lattice = np.arange(0.6, 8.0, 1.2)  # 0.6, 1.8, ..., 7.8 on [0, 10]
     out = _even_ends(lattice, 10.0, 0.75)

@@ -9,7 +9,7 @@ import pytest
 
 cq = pytest.importorskip("cadquery")
 
-from samplers.shapes import (  # noqa: E402
+from sr33.samplers.shapes import (  # noqa: E402
     Shape,
     ShapeError,
     Topology,
@@ -19,7 +19,7 @@ from samplers.shapes import (  # noqa: E402
     shape_names,
     shape_parameters,
 )
-from validators import mesh_stats  # noqa: E402
+from sr33.validators import mesh_stats  # noqa: E402
 
 NAMES = shape_names()
 
@@ -273,7 +273,7 @@ def test_numpy_numbers_are_accepted():
 
 def test_import_does_not_need_cadquery():
     code = (
-        "import sys, samplers.shapes as m; m.shape_names(); m.shape_parameters('cube'); "
+        "import sys, sr33.samplers.shapes as m; m.shape_names(); m.shape_parameters('cube'); "
         "assert 'cadquery' not in sys.modules and 'OCP' not in sys.modules"
     )
     subprocess.run([sys.executable, "-c", code], check=True)

@@ -2,8 +2,8 @@
 
 import numpy as np
 
+from sr33.validators.signature import homeomorphic, signature
 from tests.meshes import TETRA, disk, double_torus, icosphere, mobius, torus
-from validators.signature import homeomorphic, signature
 
 
 def keys(s):

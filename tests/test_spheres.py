@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from samplers.scanline import _plane_offsets
-from samplers.spheres import _circle, _Stereographic
+from sr33.samplers.scanline import _plane_offsets
+from sr33.samplers.spheres import _circle, _Stereographic
 
 
 def _sphere_points(n, centre, radius, pole, reach, seed=0):

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from validators import mesh_stats
+from sr33.validators import mesh_stats
 
 TETRA = [(0, 1, 2), (0, 3, 1), (1, 3, 2), (2, 3, 0)]
 

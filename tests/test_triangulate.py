@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from samplers import cube_lattice
 from sr33 import InputError, backtracking, localized_rng, triangulate, trivial_isometric_cycles
 from sr33.cycles import CycleSet
-from validators import edge_uses
+from sr33.samplers import cube_lattice
+from sr33.validators import edge_uses
 
 
 def area(pts, tri):

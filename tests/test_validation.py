@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from samplers import cube_lattice
 from sr33 import InputError, reconstruct
+from sr33.samplers import cube_lattice
 
 
 def test_nan_is_named_with_its_row():

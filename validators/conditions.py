@@ -2,7 +2,7 @@
 
 :func:`sample_conditions` measures Conditions II-ii, III-i and III-ii with
 geodesics on a ground-truth mesh (refined, the samples inserted as its
-vertices: :mod:`validators.refine`); it is the check to trust.
+vertices: :mod:`sr33.validators.refine`); it is the check to trust.
 
 :func:`local_delaunay`, for samples without a truth, approximates the
 intrinsic Delaunay triangulation DT_M around each sample by the Delaunay
@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
-SQRT3_2 = float(np.sqrt(3.0) / 2.0)
+from sr33.mesh import SQRT3_2, triangle_ratios, unique_rows
 
 
 @dataclass(frozen=True)
@@ -102,17 +102,7 @@ def local_delaunay(points, k: int = 12) -> LocalDelaunay:
         if simp.size == 0:
             continue
         degree[u] = np.unique(simp[simp != 0]).shape[0]
-        p = q[simp]
-        e = np.stack(
-            [
-                np.linalg.norm(p[:, 0] - p[:, 1], axis=1),
-                np.linalg.norm(p[:, 1] - p[:, 2], axis=1),
-                np.linalg.norm(p[:, 2] - p[:, 0], axis=1),
-            ],
-            axis=1,
-        )
-        e.sort(axis=1)
-        worst[u] = float((e[:, 1] / e[:, 2]).max())
+        worst[u] = float(triangle_ratios(q, simp).max())
     return LocalDelaunay(degree=degree, worst_ratio=worst)
 
 
@@ -224,7 +214,7 @@ class _Geodesics:
     def _compute(self, edges: np.ndarray) -> np.ndarray:
         import potpourri3d as pp3d
 
-        from sr33._progress import bar
+        from sr33.progress import bar
 
         from .fidelity import distance_to_surface
 
@@ -249,20 +239,6 @@ class _Geodesics:
         return length
 
 
-def _unique_rows(a: np.ndarray, return_counts: bool = False):
-    """``np.unique(a, axis=0)`` for non-negative int rows, by one int64 key
-    per row (same result and order, a 1-D sort instead of a lexicographic one)."""
-    a = np.asarray(a, dtype=np.int64)
-    base = int(a.max()) + 1 if a.size else 1
-    if base ** a.shape[1] >= 2**62:
-        return np.unique(a, axis=0, return_counts=return_counts)
-    key = np.zeros(a.shape[0], dtype=np.int64)
-    for col in range(a.shape[1]):
-        key = key * base + a[:, col]
-    _, first, counts = np.unique(key, return_index=True, return_counts=True)
-    return (a[first], counts) if return_counts else a[first]
-
-
 def _patch_sets(tv: np.ndarray, tf: np.ndarray, degrees: float):
     """Per truth vertex, the smooth patches it lies on and its normal on each.
 
@@ -283,7 +259,7 @@ def _patch_sets(tv: np.ndarray, tf: np.ndarray, degrees: float):
     adj = sparse.coo_matrix((np.ones(int(smooth.sum())), (fa[smooth], fb[smooth])), shape=(nt, nt))
     _, patch = csgraph.connected_components(adj, directed=False)
     corner = np.stack([tf.ravel(), np.repeat(patch, 3)], axis=1)
-    pairs = _unique_rows(corner)
+    pairs = unique_rows(corner)
     counts = np.bincount(pairs[:, 0], minlength=tv.shape[0])
     width = max(1, int(counts.max()))
     out = np.full((tv.shape[0], width), -1, dtype=np.int64)
@@ -383,16 +359,16 @@ def _labelled_delaunay(tv, tf, snap, pts, sharp_degrees):
     and the DT_M triangles (sorted triples).
     """
     e = np.concatenate([tf[:, [0, 1]], tf[:, [1, 2]], tf[:, [2, 0]]])
-    e = _unique_rows(np.sort(e, axis=1))
+    e = unique_rows(np.sort(e, axis=1))
     w = np.linalg.norm(tv[e[:, 0]] - tv[e[:, 1]], axis=1)
     label_of_vertex = _nearest_sample(tv, e, w, snap, pts, _patch_sets(tv, tf, sharp_degrees))
     la, lb = label_of_vertex[e[:, 0]], label_of_vertex[e[:, 1]]
     diff = (la != lb) & (la >= 0) & (lb >= 0)
     pairs = np.sort(np.stack([la[diff], lb[diff]], axis=1), axis=1).reshape(-1, 2)
-    dt_edges, crossings = _unique_rows(pairs, return_counts=True)
+    dt_edges, crossings = unique_rows(pairs, return_counts=True)
     lt = label_of_vertex[tf]
     three = (lt[:, 0] != lt[:, 1]) & (lt[:, 1] != lt[:, 2]) & (lt[:, 0] != lt[:, 2])
-    dt_tri = _unique_rows(np.sort(lt[three], axis=1).reshape(-1, 3))
+    dt_tri = unique_rows(np.sort(lt[three], axis=1).reshape(-1, 3))
     return dt_edges.reshape(-1, 2), crossings, dt_tri
 
 
@@ -435,7 +411,7 @@ def _settle(pts, tv, tf, snap, orphans, dt, resolution, sharp_degrees):
     cross = np.concatenate([crossings[~old_e], lc[new_e] // SETTLE])
     order = np.lexsort((edges[:, 1], edges[:, 0]))
     tri = np.concatenate([dt_tri[~inner[dt_tri].all(axis=1)], lt[inner[lt].all(axis=1)]])
-    return edges[order], cross[order], _unique_rows(tri)  # rows stay sorted: ids increase
+    return edges[order], cross[order], unique_rows(tri)  # rows stay sorted: ids increase
 
 
 # a DT_M edge whose two cells meet along at most this many truth edges (at the
@@ -523,7 +499,7 @@ def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8):
                 np.sort(np.concatenate([np.stack([a, c, d], 1), np.stack([b, c, d], 1)]), axis=1),
             ]
         )
-        tri = _unique_rows(tri)
+        tri = unique_rows(tri)
         gone = np.isin(edges[:, 0] * n + edges[:, 1], np.minimum(a, b) * n + np.maximum(a, b))
         new = np.sort(np.stack([c, d], 1), axis=1)
         edges = np.concatenate([edges[~gone], new])
@@ -561,9 +537,9 @@ def sample_conditions(
     crowd, Dijkstra's labels can be plainly wrong).  Geodesic lengths of
     DT_M edges are exact mesh geodesics (potpourri3d's edge-flip solver)
     between the samples.  Before that the truth is refined
-    (:func:`validators.refine.refine_to_edge_length`) until no edge is
+    (:func:`sr33.validators.refine.refine_to_edge_length`) until no edge is
     longer than ``resolution``, and every sample is made a vertex of it
-    (:func:`validators.refine.insert_points`), so that neither a coarse CAD
+    (:func:`sr33.validators.refine.insert_points`), so that neither a coarse CAD
     tessellation nor snapping distorts the lengths.
 
     Parameters
@@ -591,7 +567,7 @@ def sample_conditions(
     ConditionReport
     """
 
-    from sr33._progress import timed
+    from sr33.progress import timed
 
     from .fidelity import sharp_edges
     from .refine import insert_points, refine_to_edge_length

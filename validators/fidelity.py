@@ -13,6 +13,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sr33.mesh import edge_incidence, half_edges, surface_points, unique_rows
+
+__all__ = [
+    "Fidelity",
+    "dihedral_pairs",
+    "distance_to_surface",
+    "feature_distance",
+    "hausdorff",
+    "sharp_edges",
+    "surface_points",
+]
+
 
 @dataclass(frozen=True)
 class Fidelity:
@@ -57,21 +69,6 @@ def _polydata(vertices, triangles):
         raise ValueError(f"triangles must have shape (t, 3) with t > 0, got {t.shape}")
     faces = np.hstack([np.full((t.shape[0], 1), 3, dtype=np.int64), t]).ravel()
     return pv.PolyData(v, faces)
-
-
-def surface_points(vertices, triangles, count: int, seed: int = 0) -> np.ndarray:
-    """The vertices used by triangles plus ``count`` area-uniform random surface points."""
-    v = np.asarray(vertices, dtype=np.float64)
-    t = np.asarray(triangles, dtype=np.int64)
-    p = v[t]
-    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
-    rng = np.random.default_rng(seed)
-    pick = rng.choice(t.shape[0], size=count, p=area / area.sum())
-    r1, r2 = rng.random(count), rng.random(count)
-    s = np.sqrt(r1)
-    w = np.stack([1 - s, s * (1 - r2), s * r2], axis=1)
-    inner = np.einsum("ij,ijk->ik", w, p[pick])
-    return np.vstack([v[np.unique(t)], inner])
 
 
 def distance_to_surface(points, vertices, triangles) -> np.ndarray:
@@ -131,21 +128,16 @@ def dihedral_pairs(vertices, triangles) -> tuple[np.ndarray, np.ndarray, np.ndar
     t = np.asarray(triangles, dtype=np.int64)
     n = np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]])
     n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
-    e = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
-    face = np.tile(np.arange(t.shape[0]), 3)
-    e.sort(axis=1)
-    key = e[:, 0] * v.shape[0] + e[:, 1]
-    order = np.argsort(key, kind="stable")
-    ks = key[order]
-    same = np.flatnonzero(ks[1:] == ks[:-1])
-    fa, fb = face[order[same]], face[order[same + 1]]
-    return e[order[same]], fa, fb, (n[fa] * n[fb]).sum(axis=1)
+    inc = edge_incidence(*half_edges(t), v.shape[0])
+    e, a, b = inc.shared()
+    fa, fb = inc.face[a], inc.face[b]
+    return inc.edges[e], fa, fb, (n[fa] * n[fb]).sum(axis=1)
 
 
 def sharp_edges(vertices, triangles, degrees: float = 30.0) -> np.ndarray:
     """Edges (sorted pairs) whose two triangles' normals differ by more than ``degrees``."""
     e, _, _, cos = dihedral_pairs(vertices, triangles)
-    return np.unique(e[cos < np.cos(np.radians(degrees))], axis=0).reshape(-1, 2)
+    return unique_rows(e[cos < np.cos(np.radians(degrees))]).reshape(-1, 2)
 
 
 def feature_distance(

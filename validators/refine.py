@@ -1,7 +1,7 @@
 """Ground-truth meshes fine enough to measure geodesics between samples.
 
 The sample conditions (Section 3 of the paper) are stated with geodesic
-distances on the surface.  :mod:`validators.conditions` measures them on a
+distances on the surface.  :mod:`sr33.validators.conditions` measures them on a
 ground-truth triangle mesh, whose resolution bounds the accuracy of the
 answer; CAD tessellations are coarse on flat faces (a cube's has 8
 vertices) and the samples are not among their vertices.  Two steps fix
@@ -23,17 +23,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from sr33.mesh import closest_points_on_triangles, edge_incidence, half_edges
+
 SNAP = 1e-3  # barycentric weight below which a sample counts as on an edge / at a vertex
 
 
-def _unique_edges(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _edges_of(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Undirected edges and, per triangle, the id of local edge j = (t[j], t[j+1])."""
-    a = tri.ravel()
-    b = np.roll(tri, -1, axis=1).ravel()
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
-    key = lo * (int(tri.max()) + 1) + hi
-    uniq, first, inverse = np.unique(key, return_index=True, return_inverse=True)
-    return np.stack([lo[first], hi[first]], axis=1), inverse.reshape(-1, 3)
+    inc = edge_incidence(*half_edges(tri))
+    return inc.edges, inc.edge_of.reshape(-1, 3)
 
 
 def refine_to_edge_length(vertices, triangles, max_edge: float, *, max_triangles: int = 12_000_000):
@@ -70,7 +68,7 @@ def refine_to_edge_length(vertices, triangles, max_edge: float, *, max_triangles
     if not (np.isfinite(max_edge) and max_edge > 0):
         raise ValueError(f"max_edge must be a positive finite number, got {max_edge!r}")
     while True:
-        edges, tedge = _unique_edges(t)
+        edges, tedge = _edges_of(t)
         length = np.linalg.norm(v[edges[:, 0]] - v[edges[:, 1]], axis=1)
         split = length > max_edge
         if not split.any():
@@ -114,52 +112,6 @@ def refine_to_edge_length(vertices, triangles, max_edge: float, *, max_triangles
         out.append(np.stack([m0[right], b[right], m1[right]], 1))
         out.append(np.stack([m0[right], m1[right], c[right]], 1))
         t = np.concatenate(out)
-
-
-def _closest_on_triangles(p: np.ndarray, tri_pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Squared distance from p to each triangle and the barycentric weights of the closest point.
-
-    ``tri_pts`` is (m, 3, 3); ``p`` is (m, 3).  Ericson's region test, vectorized.
-    """
-    a, b, c = tri_pts[:, 0], tri_pts[:, 1], tri_pts[:, 2]
-    ab, ac, ap = b - a, c - a, p - a
-    d1 = np.einsum("ij,ij->i", ab, ap)
-    d2 = np.einsum("ij,ij->i", ac, ap)
-    bp = p - b
-    d3 = np.einsum("ij,ij->i", ab, bp)
-    d4 = np.einsum("ij,ij->i", ac, bp)
-    cp = p - c
-    d5 = np.einsum("ij,ij->i", ab, cp)
-    d6 = np.einsum("ij,ij->i", ac, cp)
-    va = d3 * d6 - d5 * d4
-    vb = d5 * d2 - d1 * d6
-    vc = d1 * d4 - d3 * d2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        denom = va + vb + vc
-        w = np.stack([va, vb, vc], axis=1) / denom[:, None]
-        # edge regions
-        t_ab = d1 / (d1 - d3)
-        t_ac = d2 / (d2 - d6)
-        t_bc = (d4 - d3) / ((d4 - d3) + (d5 - d6))
-    m = p.shape[0]
-    bary = w.copy()
-    sel = (vc <= 0) & (d1 >= 0) & (d3 <= 0)
-    bary[sel] = np.stack([1 - t_ab[sel], t_ab[sel], np.zeros(sel.sum())], 1)
-    sel2 = (vb <= 0) & (d2 >= 0) & (d6 <= 0)
-    bary[sel2] = np.stack([1 - t_ac[sel2], np.zeros(sel2.sum()), t_ac[sel2]], 1)
-    sel3 = (va <= 0) & ((d4 - d3) >= 0) & ((d5 - d6) >= 0)
-    bary[sel3] = np.stack([np.zeros(sel3.sum()), 1 - t_bc[sel3], t_bc[sel3]], 1)
-    for corner, cond in (
-        (0, (d1 <= 0) & (d2 <= 0)),
-        (1, (d3 >= 0) & (d4 <= d3)),
-        (2, (d6 >= 0) & (d5 <= d6)),
-    ):
-        e = np.zeros((int(cond.sum()), 3))
-        e[:, corner] = 1.0
-        bary[cond] = e
-    bary = np.nan_to_num(bary, nan=1.0 / 3.0)
-    q = np.einsum("ij,ijk->ik", bary, tri_pts)
-    return ((p - q) ** 2).sum(axis=1).reshape(m), bary
 
 
 def insert_points(vertices, triangles, points, *, candidates: int = 4):
@@ -226,7 +178,7 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
         rows = np.repeat(np.arange(pending.size), width)
         flat = cand.ravel()
         ok = flat >= 0
-        d, bary = _closest_on_triangles(pts[pending][rows[ok]], v[t[flat[ok]]])
+        d, bary = closest_points_on_triangles(pts[pending][rows[ok]], v[t[flat[ok]]])
         dist = np.full(flat.size, np.inf)
         dist[ok] = d
         full_bary = np.zeros((flat.size, 3))
@@ -235,7 +187,7 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
         at = np.arange(pending.size) * width + pick
         best_tri = flat[at]
         best_bary = full_bary[at]
-        edges, tedge = _unique_edges(t)
+        edges, tedge = _edges_of(t)
         touched = np.zeros(t.shape[0], dtype=bool)  # split this round (replaced below)
         new_tris: list[list[int]] = []
         deferred = []

@@ -25,7 +25,22 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
-from .topology import _as_triangles
+from sr33.mesh import (
+    as_triangles,
+    edge_incidence,
+    half_edges,
+    orientation_double_cover,
+    unique_rows,
+)
+
+__all__ = [
+    "Component",
+    "Signature",
+    "Verdict",
+    "homeomorphic",
+    "orientation_double_cover",
+    "signature",
+]
 
 
 @dataclass(frozen=True)
@@ -101,26 +116,6 @@ class Signature:
         return sum(c.euler for c in self.components)
 
 
-def orientation_double_cover(n: int, fa, fb, coherent) -> np.ndarray:
-    """Component labels of the orientation double cover of ``n`` faces.
-
-    Face f has nodes f ("as stored") and f + n ("flipped").  Faces ``fa[i]``
-    and ``fb[i]`` share a manifold edge; when they traverse it coherently the
-    cover joins (fa, fb) and (fa + n, fb + n), otherwise (fa, fb + n) and
-    (fa + n, fb).  A face is on a non-orientable component exactly when its
-    two nodes share a label; on an orientable one, faces whose "as stored"
-    node shares the label of a reference face's need no flip relative to it.
-    """
-    fa, fb = np.asarray(fa, dtype=np.int64), np.asarray(fb, dtype=np.int64)
-    coherent = np.asarray(coherent, dtype=bool)
-    rows = np.concatenate([fa, fa + n])
-    cols = np.concatenate([np.where(coherent, fb, fb + n), np.where(coherent, fb + n, fb)])
-    dc = sparse.csr_matrix(
-        (np.ones(rows.shape[0], dtype=np.int8), (rows, cols)), shape=(2 * n, 2 * n)
-    )
-    return csgraph.connected_components(dc, directed=False)[1]
-
-
 def _fans(tri: np.ndarray, n: int) -> np.ndarray:
     """Number of fans (edge-connected triangle groups) around every vertex."""
     t = tri.shape[0]
@@ -164,7 +159,7 @@ def signature(triangles, n_points: int | None = None, points=None) -> Signature:
     >>> [c.key() for c in s.components], s.manifold
     ([(True, 2, 0)], True)
     """
-    tri = _as_triangles(triangles)
+    tri = as_triangles(triangles)
     n = int(tri.max()) + 1 if tri.size else 0
     if n_points is not None:
         n = max(n, int(n_points))
@@ -176,24 +171,12 @@ def signature(triangles, n_points: int | None = None, points=None) -> Signature:
         p = np.asarray(points, dtype=np.float64)
         cr = np.cross(p[tri[:, 1]] - p[tri[:, 0]], p[tri[:, 2]] - p[tri[:, 0]])
         degenerate |= np.linalg.norm(cr, axis=1) == 0
-    st = np.sort(tri, axis=1)
-    duplicate = int(t - np.unique(st, axis=0).shape[0])
-
-    # directed edges of every triangle
-    d0 = np.concatenate([tri[:, 0], tri[:, 1], tri[:, 2]])
-    d1 = np.concatenate([tri[:, 1], tri[:, 2], tri[:, 0]])
-    face = np.tile(np.arange(t), 3)
-    lo, hi = np.minimum(d0, d1), np.maximum(d0, d1)
-    key = lo * n + hi
-    order = np.argsort(key, kind="stable")
-    ks = key[order]
-    uniq, start, counts = np.unique(ks, return_index=True, return_counts=True)
+    duplicate = int(t - unique_rows(np.sort(tri, axis=1)).shape[0])
+    inc = edge_incidence(*half_edges(tri), n)
+    counts = inc.counts
     overloaded = int((counts > 2).sum())
     # manifold edges: exactly two uses
-    two = start[counts == 2]
-    fa, fb = face[order[two]], face[order[two + 1]]
-    fwd = d0 < d1
-    coherent = fwd[order[two]] != fwd[order[two + 1]]
+    _, fa, fb, coherent = inc.manifold_pairs()
     incoherent = int((~coherent).sum())
     # components through shared vertices (a pinch joins them, as the surface does)
     vert_adj = sparse.csr_matrix(
@@ -207,14 +190,14 @@ def signature(triangles, n_points: int | None = None, points=None) -> Signature:
     comp_orientable[comp[twisted]] = False
     # per component figures
     f_per = np.bincount(comp, minlength=ncomp)
-    edge_face = face[order[start]]
+    edge_face = inc.face[inc.order[inc.start]]  # a triangle of every edge
     e_per = np.bincount(comp[edge_face], minlength=ncomp)
     used = np.unique(tri)
     vcomp = np.full(n, -1)
     vcomp[tri.ravel()] = np.repeat(comp, 3)
     v_per = np.bincount(vcomp[used], minlength=ncomp)
-    open_e = uniq[counts == 1]
-    ol, oh = open_e // n, open_e % n
+    open_e = inc.edges[counts == 1]
+    ol, oh = open_e[:, 0], open_e[:, 1]
     og = sparse.csr_matrix((np.ones(ol.shape[0], dtype=np.int8), (ol, oh)), shape=(n, n))
     _, olab = csgraph.connected_components(og, directed=False)
     onodes = np.unique(np.concatenate([ol, oh]))
@@ -235,8 +218,7 @@ def signature(triangles, n_points: int | None = None, points=None) -> Signature:
     fans = _fans(tri, n)
     nm = np.flatnonzero(fans > 1)
     if overloaded:
-        over_keys = uniq[counts > 2]
-        nm = np.union1d(nm, np.concatenate([over_keys // n, over_keys % n]))
+        nm = np.union1d(nm, inc.edges[counts > 2].ravel())
     unused = int(n - used.shape[0]) if n_points is not None else 0
     manifold = overloaded == 0 and nm.shape[0] == 0 and duplicate == 0 and not degenerate.any()
     return Signature(

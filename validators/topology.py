@@ -1,8 +1,8 @@
 """Topological figures of a triangle mesh, the one implementation of them.
 
-Counting is vectorized: edges are sorted vertex pairs grouped with
-``np.unique(..., axis=0, return_counts=True)``; components and boundary loops
-come from ``scipy.sparse.csgraph.connected_components``.
+Edges are counted by :func:`sr33.mesh.edge_uses` (the one edge count of
+the project); components and boundary loops come from
+``scipy.sparse.csgraph.connected_components``.
 """
 
 from __future__ import annotations
@@ -12,6 +12,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
+
+from sr33.mesh import as_triangles, edge_uses
+
+__all__ = ["MeshStats", "edge_uses", "mesh_stats"]
 
 
 @dataclass(frozen=True)
@@ -55,30 +59,6 @@ class MeshStats:
         return asdict(self)
 
 
-def _as_triangles(triangles) -> np.ndarray:
-    tri = np.asarray(triangles)
-    if tri.size == 0:
-        return np.empty((0, 3), dtype=np.int64)
-    if tri.ndim != 2 or tri.shape[1] != 3:
-        raise ValueError(f"triangles must have shape (t, 3), got {tri.shape}")
-    if not np.issubdtype(tri.dtype, np.integer):
-        raise ValueError(f"triangles must be integer indices, got dtype {tri.dtype}")
-    if tri.min() < 0:
-        raise ValueError("triangles contain negative vertex indices")
-    return tri.astype(np.int64)
-
-
-def edge_uses(triangles) -> tuple[np.ndarray, np.ndarray]:
-    """Distinct undirected edges (sorted rows) and how many triangles use each."""
-    tri = _as_triangles(triangles)
-    if tri.shape[0] == 0:
-        return np.empty((0, 2), dtype=np.int64), np.empty(0, dtype=np.int64)
-    e = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
-    e.sort(axis=1)
-    uniq, counts = np.unique(e, axis=0, return_counts=True)
-    return uniq, counts
-
-
 def _count_components(edges: np.ndarray, nodes: np.ndarray, n: int) -> int:
     if nodes.shape[0] == 0:
         return 0
@@ -105,13 +85,13 @@ def mesh_stats(triangles, n_points: int | None = None) -> MeshStats:
 
     Examples
     --------
-    >>> from validators import mesh_stats
+    >>> from sr33.validators import mesh_stats
     >>> tetra = [(0, 1, 2), (0, 3, 1), (1, 3, 2), (2, 3, 0)]
     >>> s = mesh_stats(tetra)
     >>> (s.edges, s.open_edges, s.euler, s.components)
     (6, 0, 2, 1)
     """
-    tri = _as_triangles(triangles)
+    tri = as_triangles(triangles)
     n = int(tri.max()) + 1 if tri.shape[0] else 0
     if n_points is not None:
         if n_points < n:

@@ -1,0 +1,123 @@
+"""Facts about the faces of a CAD shape, as plain arrays.
+
+Shared by the scan rows (:mod:`sr33.samplers.scanline`) and the layouts
+and repairs that follow them: exact bounds, the face nearest a point, a
+face's boundary in its own 2-D coordinates, its axis of revolution, the
+angle of an edge to the face's rows, and the greedy thinning of samples.
+CadQuery and OCP are imported only when these run.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from sr33.mesh import edge_uses
+
+RIM_SAMPLED = 0.75  # an edge is sampled when a feature sample is this near its middle (times h)
+
+
+def exact_bounds(shape) -> tuple[np.ndarray, np.ndarray]:
+    """Bounding box from the exact geometry (CadQuery's uses any cached
+    triangulation, which would make the scan planes depend on history)."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    box = Bnd_Box()
+    BRepBndLib.AddOptimal_s(shape.wrapped, box, False, False)
+    xmin, ymin, zmin, xmax, ymax, zmax = box.Get()
+    return np.array([xmin, ymin, zmin]), np.array([xmax, ymax, zmax])
+
+
+def rims_sampled(face, feature: np.ndarray, h: float) -> bool:
+    """Whether every edge of the face carries feature samples (a sharp rim):
+    one lies within ``RIM_SAMPLED`` h of the edge's middle."""
+    if feature.shape[0] == 0:
+        return False
+    mids = np.array([e.positionAt(0.5).toTuple() for e in face.Edges()])
+    if mids.shape[0] == 0:
+        return False
+    gap, _ = cKDTree(feature).query(mids)
+    return bool(gap.max() <= RIM_SAMPLED * h)
+
+
+def row_cosine(face, row_dir, u: np.ndarray) -> float | None:
+    """|cos| of the angle between the direction ``u`` (in the plane of
+    ``face``) and the face's scan rows (those of the planes with normal
+    ``row_dir``); None where the planes run along the face (no rows)."""
+    rows = np.cross(np.array(face.normalAt().toTuple()), row_dir)
+    n = float(np.linalg.norm(rows))
+    return None if n < 1e-9 else abs(float(u @ rows)) / n
+
+
+def nearest_face(p, faces) -> int:
+    import cadquery as cq
+
+    v = cq.Vertex.makeVertex(*p)
+    d = [v.distance(f) for f in faces]
+    return int(np.argmin(d))
+
+
+def thin(points: np.ndarray, radius: float) -> np.ndarray:
+    """Indices kept by a greedy pass in order: drop points within radius of a kept one."""
+    cell = radius
+    grid: dict[tuple[int, int, int], list[int]] = {}
+    keep: list[int] = []
+    r2 = radius * radius
+    keys = np.floor(points / cell).astype(np.int64)
+    for i in range(points.shape[0]):
+        kx, ky, kz = keys[i]
+        p = points[i]
+        ok = True
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                for dz in (-1, 0, 1):
+                    for j in grid.get((kx + dx, ky + dy, kz + dz), ()):
+                        q = points[j]
+                        if (p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 + (p[2] - q[2]) ** 2 < r2:
+                            ok = False
+                            break
+                    if not ok:
+                        break
+                if not ok:
+                    break
+            if not ok:
+                break
+        if ok:
+            keep.append(i)
+            grid.setdefault((int(kx), int(ky), int(kz)), []).append(i)
+    return np.array(keep, dtype=np.int64)
+
+
+def boundary_segments(face, to2d, tol: float) -> np.ndarray:
+    """Boundary edges of the face's own fine tessellation, in 2-D, as (s, 2, 2)."""
+    verts, tris = face.tessellate(tol, 0.05)
+    v = np.array([q.toTuple() for q in verts])
+    t = np.array(tris, dtype=np.int64).reshape(-1, 3)
+    uniq, counts = edge_uses(t)
+    free = uniq[counts == 1]
+    return to2d(v)[free]
+
+
+def perpendicular(v: np.ndarray) -> np.ndarray:
+    """A unit vector perpendicular to ``v``: ``v`` crossed with the coordinate
+    axis least aligned with it (a fixed choice, so frames are reproducible)."""
+    u = np.cross(v, np.eye(3)[int(np.argmin(np.abs(v)))])
+    return u / np.linalg.norm(u)
+
+
+def goes_round(face) -> bool:
+    """Whether a face of revolution goes all the way round its axis."""
+    umin, umax, _, _ = face._uvBounds()
+    return abs((umax - umin) - 2 * math.pi) <= 1e-9
+
+
+def revolution_axis(face):
+    """(point, unit direction) of a cone's, cylinder's or sphere's axis
+    (a sphere's point is its centre)."""
+    g = face._geomAdaptor()
+    kind = {"CONE": "Cone", "CYLINDER": "Cylinder"}.get(face.geomType(), "Sphere")
+    pos = getattr(g, kind)().Position()
+    return np.array(pos.Location().Coord()), np.array(pos.Direction().Coord())

@@ -1,0 +1,467 @@
+"""Mesh primitives shared by every layer of sr33: the one implementation of each.
+
+The reconstruction, the validators, the samplers and the inspector all count
+edges, link faces across shared edges, orient them, test triangles for
+intersection, find closest points and measure the Condition III-ii ratio;
+they do it here.  Plain numpy and scipy; arrays in, arrays out (points
+``(n, 3)`` or ``(n, 2)`` float64, indices int64).
+
+* :func:`unique_rows`, :func:`edge_keys`, :func:`unique_edges`: grouping by
+  one int64 key per row (a 1-D sort instead of a lexicographic one).
+* :func:`half_edges`, :func:`edge_incidence`, :class:`EdgeIncidence`,
+  :func:`edge_uses`: every face's directed edges grouped by undirected edge
+  (use counts, the faces two uses link, whether they agree in direction).
+* :func:`orientation_double_cover`: orientability and coherent orientation.
+* :func:`self_intersections`: pairs of triangles whose interiors meet.
+* :func:`closest_points_on_triangles`: Ericson's region test, vectorized.
+* :func:`triangle_ratios` and ``SQRT3_2``: Condition III-ii of the paper.
+* :func:`surface_points`: area-uniform points on a triangle mesh.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse import csgraph
+
+SQRT3_2 = float(np.sqrt(3.0) / 2.0)  # Condition III-ii: shorter edges below this times the longest
+
+
+def edge_keys(a, b, n: int) -> np.ndarray:
+    """Order-free int64 key ``min * n + max`` of the undirected edges (a, b)."""
+    a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
+    return np.minimum(a, b) * int(n) + np.maximum(a, b)
+
+
+def unique_rows(a, return_counts: bool = False):
+    """``np.unique(a, axis=0)`` for rows of non-negative ints (same rows, same order).
+
+    One int64 key per row makes it a 1-D sort; rows too wide for one key fall
+    back to numpy's lexicographic sort.
+
+    Examples
+    --------
+    >>> unique_rows([[2, 1], [0, 3], [2, 1]], return_counts=True)
+    (array([[0, 3],
+           [2, 1]]), array([1, 2]))
+    """
+    a = np.asarray(a, dtype=np.int64)
+    if a.ndim != 2:
+        raise ValueError(f"rows must be a 2-D array, got shape {a.shape}")
+    base = int(a.max()) + 1 if a.size else 1
+    if a.shape[1] == 0 or float(base) ** a.shape[1] >= 2.0**62:
+        return np.unique(a, axis=0, return_counts=return_counts)
+    key = np.zeros(a.shape[0], dtype=np.int64)
+    for col in range(a.shape[1]):
+        key = key * base + a[:, col]
+    _, first, counts = np.unique(key, return_index=True, return_counts=True)
+    return (a[first], counts) if return_counts else a[first]
+
+
+def unique_edges(pairs, return_counts: bool = False):
+    """Distinct undirected edges (sorted rows, sorted order) of vertex pairs."""
+    p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    return unique_rows(np.sort(p, axis=1), return_counts=return_counts)
+
+
+def half_edges(triangles) -> tuple[np.ndarray, np.ndarray]:
+    """The directed edges of triangles and the triangle of each.
+
+    Row ``3 f + j`` is the edge ``(t[f, j], t[f, (j + 1) % 3])``, so that
+    ``values.reshape(-1, 3)`` gives per-triangle answers in local edge order.
+    """
+    t = as_triangles(triangles)
+    pairs = np.stack([t.ravel(), np.roll(t, -1, axis=1).ravel()], axis=1)
+    return pairs, np.repeat(np.arange(t.shape[0], dtype=np.int64), 3)
+
+
+@dataclass(frozen=True)
+class EdgeIncidence:
+    """Directed edges of faces grouped by their undirected edge.
+
+    Attributes
+    ----------
+    edges : (e, 2) int64
+        The distinct undirected edges, sorted rows in sorted order.
+    counts : (e,) int64
+        How many directed edges (face sides) use each.
+    edge_of : (h,) int64
+        The edge (row of ``edges``) of every directed edge.
+    face : (h,) int64
+        The face of every directed edge.
+    forward : (h,) bool
+        Whether a directed edge runs from the smaller vertex to the larger.
+    order : (h,) int64
+        The directed edges sorted by edge (stable): the uses of edge i are
+        ``order[start[i]:start[i] + counts[i]]``.
+    start : (e,) int64
+        Where each edge's uses begin in ``order``.
+    """
+
+    edges: np.ndarray
+    counts: np.ndarray
+    edge_of: np.ndarray
+    face: np.ndarray
+    forward: np.ndarray
+    order: np.ndarray
+    start: np.ndarray
+
+    def shared(self, uses: int | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Consecutive uses of every edge used more than once: (edge, first
+        use, second use), an edge of k uses giving k - 1 pairs; with ``uses``,
+        only edges of exactly that many uses."""
+        used = np.repeat(self.counts, self.counts)[:-1] if self.order.size else self.counts[:0]
+        same = np.flatnonzero(self.edge_of[self.order[1:]] == self.edge_of[self.order[:-1]])
+        if uses is not None:
+            same = same[used[same] == uses]
+        a, b = self.order[same], self.order[same + 1]
+        return self.edge_of[a], a, b
+
+    def manifold_pairs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Edges used exactly twice: (edge, face a, face b, coherent), where
+        coherent means the two faces traverse the edge in opposite directions."""
+        e, a, b = self.shared(uses=2)
+        return e, self.face[a], self.face[b], self.forward[a] != self.forward[b]
+
+
+def edge_incidence(pairs, face, n: int | None = None) -> EdgeIncidence:
+    """Group directed edges (``pairs[i]`` a side of face ``face[i]``) by edge.
+
+    Parameters
+    ----------
+    pairs : (h, 2) array_like of int
+        Directed edges.
+    face : (h,) array_like of int
+        The face each belongs to.
+    n : int, optional
+        Number of vertices (defaults to the largest index + 1).
+
+    Returns
+    -------
+    EdgeIncidence
+
+    Examples
+    --------
+    >>> inc = edge_incidence(*half_edges([(0, 1, 2), (0, 2, 3)]))
+    >>> inc.edges.tolist(), inc.counts.tolist()
+    ([[0, 1], [0, 2], [0, 3], [1, 2], [2, 3]], [1, 2, 1, 1, 1])
+    >>> [x.tolist() for x in inc.manifold_pairs()]
+    [[1], [0], [1], [True]]
+    """
+    p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    f = np.asarray(face, dtype=np.int64)
+    n = int(p.max()) + 1 if n is None and p.size else int(n or 0)
+    n = max(n, 1)
+    key = edge_keys(p[:, 0], p[:, 1], n)
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    first = np.r_[True, ks[1:] != ks[:-1]] if ks.size else np.zeros(0, dtype=bool)
+    start = np.flatnonzero(first)
+    edge_of = np.empty(p.shape[0], dtype=np.int64)
+    edge_of[order] = np.cumsum(first) - 1
+    uniq = ks[start]
+    return EdgeIncidence(
+        edges=np.stack([uniq // n, uniq % n], axis=1).reshape(-1, 2),
+        counts=np.diff(np.r_[start, ks.size]).astype(np.int64),
+        edge_of=edge_of,
+        face=f,
+        forward=p[:, 0] < p[:, 1],
+        order=order.astype(np.int64),
+        start=start.astype(np.int64),
+    )
+
+
+def as_triangles(triangles) -> np.ndarray:
+    """Triangles as a ``(t, 3)`` int64 array (an empty input gives ``(0, 3)``)."""
+    tri = np.asarray(triangles)
+    if tri.size == 0:
+        return np.empty((0, 3), dtype=np.int64)
+    if tri.ndim != 2 or tri.shape[1] != 3:
+        raise ValueError(f"triangles must have shape (t, 3), got {tri.shape}")
+    if not np.issubdtype(tri.dtype, np.integer):
+        raise ValueError(f"triangles must be integer indices, got dtype {tri.dtype}")
+    if tri.min() < 0:
+        raise ValueError("triangles contain negative vertex indices")
+    return tri.astype(np.int64)
+
+
+def edge_uses(triangles) -> tuple[np.ndarray, np.ndarray]:
+    """Distinct undirected edges of triangles (sorted rows) and how many triangles use each.
+
+    Examples
+    --------
+    >>> e, c = edge_uses([(0, 1, 2), (0, 2, 3)])
+    >>> e[c == 2].tolist()
+    [[0, 2]]
+    """
+    tri = as_triangles(triangles)
+    if tri.shape[0] == 0:
+        return np.empty((0, 2), dtype=np.int64), np.empty(0, dtype=np.int64)
+    return unique_edges(half_edges(tri)[0], return_counts=True)
+
+
+def orientation_double_cover(n: int, fa, fb, coherent) -> np.ndarray:
+    """Component labels of the orientation double cover of ``n`` faces.
+
+    Face f has nodes f ("as stored") and f + n ("flipped").  Faces ``fa[i]``
+    and ``fb[i]`` share a manifold edge; when they traverse it coherently the
+    cover joins (fa, fb) and (fa + n, fb + n), otherwise (fa, fb + n) and
+    (fa + n, fb).  A face is on a non-orientable component exactly when its
+    two nodes share a label; on an orientable one, faces whose "as stored"
+    node shares the label of a reference face's need no flip relative to it.
+
+    Examples
+    --------
+    >>> lab = orientation_double_cover(2, [0], [1], [False])
+    >>> bool(lab[0] == lab[1 + 2])  # face 1 must flip to agree with face 0
+    True
+    """
+    fa, fb = np.asarray(fa, dtype=np.int64), np.asarray(fb, dtype=np.int64)
+    coherent = np.asarray(coherent, dtype=bool)
+    rows = np.concatenate([fa, fa + n])
+    cols = np.concatenate([np.where(coherent, fb, fb + n), np.where(coherent, fb + n, fb)])
+    dc = sparse.csr_matrix(
+        (np.ones(rows.shape[0], dtype=np.int8), (rows, cols)), shape=(2 * n, 2 * n)
+    )
+    _, labels = csgraph.connected_components(dc, directed=False)
+    return labels
+
+
+def triangle_ratios(points, triangles) -> np.ndarray:
+    """Per triangle, its second-longest edge over its longest.
+
+    Condition III-ii of the paper asks every intrinsic Delaunay triangle for
+    a ratio below ``SQRT3_2`` (both shorter edges below √3/2 of the
+    longest); a square lattice's right isosceles triangles have 1/√2.
+    Works on 2-D and 3-D points.
+
+    Examples
+    --------
+    >>> round(float(triangle_ratios([[0, 0], [1, 0], [0, 1]], [(0, 1, 2)])[0]), 4)
+    0.7071
+    """
+    p = np.asarray(points, dtype=np.float64)[as_triangles(triangles)]
+    length = np.sort(np.sqrt(((p - p[:, [1, 2, 0]]) ** 2).sum(axis=2)), axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return length[:, 1] / length[:, 2]
+
+
+def closest_points_on_triangles(p, corners) -> tuple[np.ndarray, np.ndarray]:
+    """Squared distance from each point to its triangle and the closest point's
+    barycentric weights (Ericson, *Real-Time Collision Detection* 5.1.5).
+
+    Parameters
+    ----------
+    p : (m, 3) array_like of float
+    corners : (m, 3, 3) array_like of float
+        Row i: the corners of the triangle point i is measured against.
+
+    Returns
+    -------
+    distance2 : (m,) float64
+    weights : (m, 3) float64
+        Weights of the corners (a degenerate triangle's closest point is
+        taken at its centroid where the regions cannot decide).
+
+    Examples
+    --------
+    >>> d2, w = closest_points_on_triangles([[0.2, 0.2, 1.0]], [[[0, 0, 0], [1, 0, 0], [0, 1, 0]]])
+    >>> float(d2[0]), w.round(2).tolist()
+    (1.0, [[0.6, 0.2, 0.2]])
+    """
+    p = np.asarray(p, dtype=np.float64).reshape(-1, 3)
+    tri_pts = np.asarray(corners, dtype=np.float64).reshape(-1, 3, 3)
+    a, b, c = tri_pts[:, 0], tri_pts[:, 1], tri_pts[:, 2]
+
+    def dot(x, y):
+        return np.einsum("ij,ij->i", x, y)
+
+    ab, ac, ap = b - a, c - a, p - a
+    d1, d2 = dot(ab, ap), dot(ac, ap)
+    bp = p - b
+    d3, d4 = dot(ab, bp), dot(ac, bp)
+    cp = p - c
+    d5, d6 = dot(ab, cp), dot(ac, cp)
+    va = d3 * d6 - d5 * d4
+    vb = d5 * d2 - d1 * d6
+    vc = d1 * d4 - d3 * d2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = np.stack([va, vb, vc], axis=1) / (va + vb + vc)[:, None]
+        t_ab = d1 / (d1 - d3)
+        t_ac = d2 / (d2 - d6)
+        t_bc = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+    zero = np.zeros(p.shape[0])
+    regions = [  # later regions win: edges over the face, corners over edges
+        ((vc <= 0) & (d1 >= 0) & (d3 <= 0), np.stack([1 - t_ab, t_ab, zero], 1)),
+        ((vb <= 0) & (d2 >= 0) & (d6 <= 0), np.stack([1 - t_ac, zero, t_ac], 1)),
+        ((va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0), np.stack([zero, 1 - t_bc, t_bc], 1)),
+        ((d1 <= 0) & (d2 <= 0), np.eye(3)[[0]]),
+        ((d3 >= 0) & (d4 <= d3), np.eye(3)[[1]]),
+        ((d6 >= 0) & (d5 <= d6), np.eye(3)[[2]]),
+    ]
+    for sel, value in regions:
+        w = np.where(sel[:, None], value, w)
+    w = np.nan_to_num(w, nan=1.0 / 3.0)
+    q = np.einsum("ij,ijk->ik", w, tri_pts)
+    return ((p - q) ** 2).sum(axis=1), w
+
+
+def surface_points(vertices, triangles, count: int, seed: int = 0) -> np.ndarray:
+    """The vertices triangles use plus ``count`` area-uniform random surface points (seeded)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    t = as_triangles(triangles)
+    p = v[t]
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    rng = np.random.default_rng(seed)
+    pick = rng.choice(t.shape[0], size=count, p=area / area.sum())
+    r1, r2 = rng.random(count), rng.random(count)
+    s = np.sqrt(r1)
+    w = np.stack([1 - s, s * (1 - r2), s * r2], axis=1)
+    inner = np.einsum("ij,ijk->ik", w, p[pick])
+    return np.vstack([v[np.unique(t)], inner])
+
+
+# --- triangle intersection -------------------------------------------------
+
+
+def _segments_cross_triangles(p0, p1, a, b, c, eps):
+    """Vectorized: does the open segment p0-p1 cross the triangle abc (interior or edge)?"""
+    d = p1 - p0
+    e1, e2 = b - a, c - a
+    h = np.cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, h)
+    ok = np.abs(det) > eps
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    s = p0 - a
+    u = inv * np.einsum("ij,ij->i", s, h)
+    q = np.cross(s, e1)
+    v = inv * np.einsum("ij,ij->i", d, q)
+    t = inv * np.einsum("ij,ij->i", e2, q)
+    tol = 1e-12
+    return ok & (u >= -tol) & (v >= -tol) & (u + v <= 1 + tol) & (t > tol) & (t < 1 - tol)
+
+
+def _candidate_pairs(lo: np.ndarray, hi: np.ndarray, keep=None) -> np.ndarray:
+    """Pairs of boxes sharing a cell of a uniform grid (cell = median box size).
+
+    Every box is entered in each cell it overlaps; pairs are generated per
+    cell, filtered by ``keep`` (if given) before deduplication, and reported
+    once.  Unlike one search radius for all, a few large triangles do not
+    make every small one a candidate of every other.
+    """
+    ext = (hi - lo).max(axis=1)
+    cell = float(np.median(ext)) or float(ext.max()) or 1.0
+    origin = lo.min(axis=0)
+    c0 = np.floor((lo - origin) / cell).astype(np.int64)
+    c1 = np.floor((hi - origin) / cell).astype(np.int64)
+    span = c1 - c0 + 1
+    count = span.prod(axis=1)
+    owner = np.repeat(np.arange(lo.shape[0]), count)
+    start = np.repeat(np.cumsum(count) - count, count)
+    k = np.arange(owner.shape[0]) - start
+    sx, sy = span[owner, 0], span[owner, 1]
+    ix = c0[owner, 0] + k % sx
+    iy = c0[owner, 1] + (k // sx) % sy
+    iz = c0[owner, 2] + k // (sx * sy)
+    dims = c1.max(axis=0) + 1
+    key = (ix * dims[1] + iy) * dims[2] + iz
+    order = np.argsort(key, kind="stable")
+    key, owner = key[order], owner[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    sizes = np.diff(np.r_[starts, key.shape[0]])
+    # every element pairs with the later elements of its cell, vectorized
+    group_end = np.repeat(starts + sizes, sizes)
+    later = group_end - np.arange(key.shape[0]) - 1
+    if later.sum() == 0:
+        return np.empty((0, 2), dtype=np.int64)
+    first = np.repeat(np.arange(key.shape[0]), later)
+    offset = np.arange(first.shape[0]) - np.repeat(np.cumsum(later) - later, later)
+    a, b = owner[first], owner[first + 1 + offset]
+    ok = a != b
+    if keep is not None:
+        ok &= keep(a, b)
+    a, b = a[ok], b[ok]
+    n = lo.shape[0]
+    keys = np.unique(edge_keys(a, b, n))
+    return np.stack([keys // n, keys % n], axis=1)
+
+
+def self_intersections(vertices, triangles, keep=None) -> np.ndarray:
+    """Pairs (i, j), i < j, of triangles whose interiors intersect.
+
+    The paper requires the triangles of the output to have pairwise disjoint
+    interiors (Section 4, Triangulate).  Candidate pairs share a cell of a
+    grid and overlap as boxes; each is decided by exact segment–triangle
+    tests (Möller–Trumbore): two non-coplanar triangles intersect exactly
+    when an edge of one crosses the other.  Pairs sharing an edge are
+    adjacent, not intersecting, unless they fold onto each other (coplanar
+    and on the same side); pairs sharing one vertex intersect when an edge
+    not at that vertex crosses the other.
+
+    Parameters
+    ----------
+    vertices : (n, 3) array_like of float
+    triangles : (t, 3) array_like of int
+    keep : callable, optional
+        ``keep(i, j) -> bool array`` filters the candidate pairs before the
+        exact tests (callers that only care about some pairs).
+
+    Returns
+    -------
+    (p, 2) int64, sorted rows.
+
+    Examples
+    --------
+    >>> v = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0],
+    ...               [0.5, 0.5, -1], [0.5, 0.5, 1], [3, 3, 0]], float)
+    >>> self_intersections(v, [(0, 1, 2), (3, 4, 5)]).tolist()
+    [[0, 1]]
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    if t.shape[0] < 2:
+        return np.empty((0, 2), dtype=np.int64)
+    p = v[t]
+    scale = float(np.abs(v).max()) or 1.0
+    eps = 1e-14 * scale * scale
+    lo, hi = p.min(axis=1), p.max(axis=1)
+    pairs = _candidate_pairs(lo, hi, keep)
+    if pairs.shape[0] == 0:
+        return np.empty((0, 2), dtype=np.int64)
+    i, j = pairs[:, 0], pairs[:, 1]
+    box = np.all((lo[i] <= hi[j]) & (lo[j] <= hi[i]), axis=1)
+    i, j = i[box], j[box]
+    ti, tj = t[i], t[j]
+    shared = (ti[:, :, None] == tj[:, None, :]).sum(axis=(1, 2))
+    hit = np.zeros(i.shape[0], dtype=bool)
+    # edges of one triangle that do not touch a shared vertex, against the other
+    for dst, ts, td in ((j, ti, tj), (i, tj, ti)):
+        for k in range(3):
+            a_idx, b_idx = ts[:, k], ts[:, (k + 1) % 3]
+            touches = (a_idx[:, None] == td).any(axis=1) | (b_idx[:, None] == td).any(axis=1)
+            sel = np.flatnonzero(~touches)
+            if not sel.size:
+                continue
+            r = _segments_cross_triangles(
+                v[a_idx[sel]], v[b_idx[sel]], p[dst[sel], 0], p[dst[sel], 1], p[dst[sel], 2], eps
+            )
+            hit[sel[r]] = True
+    # pairs sharing an edge: a fold when the two third vertices are coplanar and on one side
+    two = np.flatnonzero((shared == 2) & ~hit)
+    if two.shape[0]:
+        a, b = ti[two], tj[two]
+        in_b = (a[:, :, None] == b[:, None, :]).any(axis=2)
+        in_a = (b[:, :, None] == a[:, None, :]).any(axis=2)
+        oa = a[~in_b]
+        ob = b[~in_a]
+        common = a[in_b].reshape(-1, 2)
+        e0, e1 = v[common[:, 0]], v[common[:, 1]]
+        na = np.cross(e1 - e0, v[oa] - e0)
+        nb = np.cross(e1 - e0, v[ob] - e0)
+        la, lb = np.linalg.norm(na, axis=1), np.linalg.norm(nb, axis=1)
+        cos = np.einsum("ij,ij->i", na, nb) / np.maximum(la * lb, 1e-300)
+        hit[two[cos > 1 - 1e-12]] = True
+    out = np.stack([np.minimum(i[hit], j[hit]), np.maximum(i[hit], j[hit])], axis=1)
+    return unique_rows(out) if out.shape[0] else out.reshape(0, 2)
