@@ -1,19 +1,21 @@
 # One command each: `make demo` and `make test` create .venv and install on
-# first use; re-running them reinstalls only when pyproject.toml changed.
+# first use; re-running them reinstalls only when pyproject.toml or
+# constraints.txt changed.  constraints.txt pins every package the results
+# depend on (CadQuery/OCP tessellation, numpy, scipy, numba, qhull).
 PY      ?= python3
 VENV    := .venv
 BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed
 DATA    ?= ../shared/datasets
 
-.PHONY: install demo demo-paper test bench bench-compare lint fuzz clean
+.PHONY: install demo demo-paper test check bench bench-compare lint fuzz lock clean
 
 install: $(STAMP)
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m pip install --quiet -c constraints.txt -e '.[test]'
 	touch $(STAMP)
 
 # the main job end to end: sample a sharp CAD shape (a block with two
@@ -32,14 +34,28 @@ demo-paper: $(STAMP)
 	mkdir -p out
 	$(BIN)/sr33 reconstruct $(DATA)/paper/large/cube.obj -k 33 -o out/cube.ply
 
+# the suite a developer runs often (what .ci/run calls): ruff, then every
+# test not marked slow, on two workers
 test: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile -m "not slow"
+
+# the slow checks: the geodesic Condition III of every library shape's
+# default sampling, every default sampling's contract and reconstruction,
+# 20k-point samplings (see the README for their times)
+check: $(STAMP)
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile -m slow
 
 bench: $(STAMP)
 	$(BIN)/python bench/run.py --data $(DATA) --out out/bench.json
 	$(BIN)/python bench/samplers_report.py --out out/samplers.json
 	$(BIN)/python bench/validators_bench.py
+
+# the installed versions, written back as the pins (after a deliberate upgrade)
+lock: $(STAMP)
+	head -3 constraints.txt > constraints.new
+	$(BIN)/python -m pip freeze --exclude-editable | sort >> constraints.new
+	mv constraints.new constraints.txt
 
 fuzz: $(STAMP)
 	HYPOTHESIS_PROFILE=deep FUZZ_REPORT=1 $(BIN)/python -m pytest -q -p no:cacheprovider tests/test_properties.py

@@ -33,6 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sr33.mesh import dot, norm
+
 from .adjacency import EdgeFaces
 from .chart import halving_count, radial_clamp
 from .faces import goes_round, perpendicular
@@ -80,7 +82,7 @@ def _as_round(fi: int, face, tol: float) -> RoundFace | None:
     if any(e.geomType() != "CIRCLE" or not e.IsClosed() for e in edges):
         return None
     centres = [np.array(e.arcCenter().toTuple()) for e in edges]
-    if np.linalg.norm(centres[-1] - centres[0]) > tol:
+    if norm(centres[-1] - centres[0]) > tol:
         return None
     order = sorted(range(len(edges)), key=lambda k: -edges[k].radius())
     radii = tuple(float(edges[k].radius()) for k in order)
@@ -261,7 +263,7 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
         ex = perpendicular(rf.normal)
         ey = np.cross(rf.normal, ex)
         q = s.points - rf.centre
-        off = q @ rf.normal
+        off = dot(q, rf.normal)
         radial = np.linalg.norm(q - off[:, None] * rf.normal, axis=1)
         lo = rf.radii[1] if len(rf.radii) > 1 else 0.0
         mine = (np.abs(off) < tol) & (radial < rf.radii[0] + tol) & (radial > lo - tol)

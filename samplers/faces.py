@@ -14,7 +14,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from sr33.mesh import edge_uses
+from sr33.mesh import dot, edge_uses, norm
 
 RIM_SAMPLED = 0.75  # an edge is sampled when a feature sample is this near its middle (times h)
 
@@ -48,8 +48,8 @@ def row_cosine(face, row_dir, u: np.ndarray) -> float | None:
     ``face``) and the face's scan rows (those of the planes with normal
     ``row_dir``); None where the planes run along the face (no rows)."""
     rows = np.cross(np.array(face.normalAt().toTuple()), row_dir)
-    n = float(np.linalg.norm(rows))
-    return None if n < 1e-9 else abs(float(u @ rows)) / n
+    n = float(norm(rows))
+    return None if n < 1e-9 else abs(float(dot(u, rows))) / n
 
 
 def nearest_face(p, faces) -> int:
@@ -105,7 +105,7 @@ def perpendicular(v: np.ndarray) -> np.ndarray:
     """A unit vector perpendicular to ``v``: ``v`` crossed with the coordinate
     axis least aligned with it (a fixed choice, so frames are reproducible)."""
     u = np.cross(v, np.eye(3)[int(np.argmin(np.abs(v)))])
-    return u / np.linalg.norm(u)
+    return u / norm(u)
 
 
 def goes_round(face) -> bool:

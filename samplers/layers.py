@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
-from sr33.mesh import SQRT3_2, triangle_ratios
+from sr33.mesh import SQRT3_2, dot, norm, triangle_ratios
 
 from .adjacency import EdgeFaces
 from .chart import (
@@ -163,7 +163,7 @@ def _plane_frame(face):
         u = perpendicular(n)
         v = np.cross(n, u)
     o = np.array(face.Center().toTuple())
-    o = n * float(n @ o)  # the plane's point nearest the origin: parallel faces share u, v
+    o = n * float(dot(n, o))  # the plane's point nearest the origin: parallel faces share u, v
     return o, u, v, n
 
 
@@ -183,7 +183,7 @@ class _Line:
     def along(self, p: np.ndarray) -> np.ndarray:
         """The edge parameter of each point's foot (0 at ``a``, 1 at ``b``)."""
         d = self.b - self.a
-        return (p - self.a) @ d / (d @ d)
+        return dot(p - self.a, d) / (dot(d, d))
 
     def distance(self, p: np.ndarray) -> np.ndarray:
         t = np.clip(self.along(p), 0.0, 1.0)
@@ -192,7 +192,7 @@ class _Line:
     def project(self, p: np.ndarray, margin: float) -> np.ndarray:
         """The nearest point of the edge at least ``margin`` from its ends."""
         d = self.b - self.a
-        m = margin / float(np.linalg.norm(d))
+        m = margin / float(norm(d))
         t = np.clip(self.along(p), m, 1.0 - m)
         return self.a + t[:, None] * d
 
@@ -218,7 +218,7 @@ def _step_fits(s: Samples, a3: np.ndarray, u: np.ndarray, length: float, h: floa
     to that bound and leaves the excess in a few gaps of 2 h, whose columns
     break III-ii all along the face they follow (7.9% of the samples)."""
     q = s.points[s.on_feature] - a3
-    t = q @ u
+    t = dot(q, u)
     off = np.linalg.norm(q - t[:, None] * u, axis=1)
     t = np.sort(t[(off < 1e-6 * h) & (t > 1e-9 * length) & (t < length * (1 - 1e-9))])
     return t.size < 3 or float(np.diff(t).max()) <= GAP[1] * h
@@ -232,7 +232,7 @@ def _plain_lattice(face, row_dir) -> bool:
         if e.geomType() != "LINE":
             return False
         u = np.array(e.endPoint().toTuple()) - np.array(e.startPoint().toTuple())
-        if _slanted(face, row_dir, u / np.linalg.norm(u)):
+        if _slanted(face, row_dir, u / norm(u)):
             return False
     return True
 
@@ -256,7 +256,7 @@ def _slanted_lines(occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs) -
             continue
         a3 = np.array(e.startPoint().toTuple())
         b3 = np.array(e.endPoint().toTuple())
-        length = float(np.linalg.norm(b3 - a3))
+        length = float(norm(b3 - a3))
         u = (b3 - a3) / length
         if not _slanted(face, np.asarray(row_dirs[fi]), u):
             continue
@@ -269,7 +269,7 @@ def _slanted_lines(occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs) -
             m, m3 = -m, -m3
         sel = np.flatnonzero((s.face_id == fb) & ~s.on_feature)
         q = s.points[sel]
-        t = (q - a3) @ u
+        t = dot(q - a3, u)
         foot = a3 + t[:, None] * u
         dist = np.linalg.norm(q - foot, axis=1)
         near = (t > 0) & (t < length) & (dist < LAYER * h)
@@ -304,7 +304,7 @@ def _clamp_lines(lines: list[_Line], h: float):
         out = p.copy()
         for ln in lines:
             t = ln.along(out)
-            inward = (out - ln.a) @ ln.inward
+            inward = dot(out - ln.a, ln.inward)
             bad = (t > 0) & (t < 1) & (inward < 0.4 * h) & (inward > -2 * h)
             if bad.any():
                 out[bad] += (0.4 * h - inward[bad])[:, None] * ln.inward
@@ -374,7 +374,7 @@ def repair_planar_faces(
 
         def to2d(p, o=o, u=u, v=v):
             q = np.asarray(p, dtype=np.float64) - o
-            return np.stack([q @ u, q @ v], axis=1)
+            return np.stack([dot(q, u), dot(q, v)], axis=1)
 
         arcs = _arcs(face, to2d, [(e, faces[fb], fb) for e, fb in nbrs[fi] if fb >= 0])
         if not arcs and row_dirs is None:
@@ -388,7 +388,7 @@ def repair_planar_faces(
         )
         if not arcs and not lines:
             continue
-        on_plane = np.abs((s.points - o) @ n) < tol
+        on_plane = np.abs(dot(s.points - o, n)) < tol
         cand = np.flatnonzero(on_plane)
         uv = to2d(s.points[cand])
         # the face's samples: inside it, or on its boundary (the tessellation's
@@ -456,10 +456,11 @@ def repair_planar_faces(
                 cur = np.flatnonzero(feat & (a.distance(uv) < tol))
                 if a.wall in walls and cur.size == walls[a.wall].shape[0]:
                     rec = walls[a.wall]
-                    rec = to2d(rec - np.outer((rec - o) @ n, n))
+                    rec = to2d(rec - np.outer(dot(rec - o, n), n))
                     ang_cur = np.arctan2(*(uv[cur] - a.centre).T[::-1])
                     ang_rec = np.arctan2(*(rec - a.centre).T[::-1])
-                    uv[cur[np.argsort(ang_cur)]] = rec[np.argsort(ang_rec)]
+                    by_cur = np.argsort(ang_cur, kind="stable")
+                    uv[cur[by_cur]] = rec[np.argsort(ang_rec, kind="stable")]
                     slide[cur] = False
             sides = arc_sides(arcs, raster, h)
             clamps = ([arc_clamp(arcs, sides, h)] if arcs else []) + (
@@ -499,11 +500,11 @@ def repair_planar_faces(
         for ln in follow:
             rows = slid[ln.distance(r.uv[slid]) < tol]
             a3, b3 = ln.ends3
-            length = float(np.linalg.norm(b3 - a3))
+            length = float(norm(b3 - a3))
             u3 = (b3 - a3) / length
-            s0 = (s.points[src[rows]] - a3) @ u3
-            s1 = (pts3[rows] - a3) @ u3
-            order = np.argsort(s0)
+            s0 = dot(s.points[src[rows]] - a3, u3)
+            s1 = dot(pts3[rows] - a3, u3)
+            order = np.argsort(s0, kind="stable")
             shifts.setdefault(ln.other, []).append(
                 (a3, u3, np.r_[0.0, s0[order], length], np.r_[0.0, (s1 - s0)[order], 0.0])
             )
@@ -553,15 +554,16 @@ def _follow_columns(s: Samples, shifts: dict[int, list], faces, tol: float) -> N
         n = np.array(faces[fb].normalAt().toTuple())
         corners = np.array([q.toTuple() for q in faces[fb].Vertices()])
         o = corners[0]
-        sel = np.flatnonzero((s.face_id == fb) & ~s.on_feature & (np.abs((s.points - o) @ n) < tol))
+        on = np.abs(dot(s.points - o, n)) < tol
+        sel = np.flatnonzero((s.face_id == fb) & ~s.on_feature & on)
         if sel.size == 0:
             continue
         q = s.points[sel]
         move = np.zeros_like(q)
         for a3, u3, at, shift in records:
-            t = (q - a3) @ u3
+            t = dot(q - a3, u3)
             w = np.linalg.norm(q - a3 - t[:, None] * u3, axis=1)
-            tc = (corners - a3) @ u3
+            tc = dot(corners - a3, u3)
             width = float(np.linalg.norm(corners - a3 - tc[:, None] * u3, axis=1).max())
             scale = np.clip(1.0 - w / width, 0.0, 1.0)
             move += (np.interp(t, at, shift) * scale)[:, None] * u3
@@ -599,11 +601,11 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
         ez = np.array(pos.Direction().Coord())
         radius = cyl.Radius()
         q = s.points - o
-        axial = q @ ez
+        axial = dot(q, ez)
         radial = np.linalg.norm(q - axial[:, None] * ez, axis=1)
         mine = (np.abs(radial - radius) < tol) & (axial > vmin - tol) & (axial < vmax + tol)
         idx = np.flatnonzero(mine)
-        ang = np.arctan2(q[idx] @ ey, q[idx] @ ex) % (2 * math.pi)
+        ang = np.arctan2(dot(q[idx], ey), dot(q[idx], ex)) % (2 * math.pi)
         rim_lo = s.on_feature[idx] & (np.abs(axial[idx] - vmin) < tol)
         rim_hi = s.on_feature[idx] & (np.abs(axial[idx] - vmax) < tol)
         a_lo, a_hi = np.sort(ang[rim_lo]), np.sort(ang[rim_hi])
@@ -666,15 +668,15 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         pos = cone.Position()
         apex = np.array(cone.Apex().Coord())
         loc = np.array(pos.Location().Coord())
-        if np.linalg.norm(loc - apex) < tol:
+        if norm(loc - apex) < tol:
             continue
-        axis = (loc - apex) / np.linalg.norm(loc - apex)
+        axis = (loc - apex) / norm(loc - apex)
         ex = np.array(pos.XDirection().Coord())
         ey = np.cross(axis, ex)
         tan_a = math.tan(abs(cone.SemiAngle()))
         sin_a = math.sin(abs(cone.SemiAngle()))
         q = s.points - apex
-        along = q @ axis
+        along = dot(q, axis)
         radial = np.linalg.norm(q - along[:, None] * axis, axis=1)
         on = np.abs(radial - along * tan_a) < tol * 10
         # the rim: feature samples of the face at its largest distance from the apex
@@ -688,7 +690,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         slant = top / math.cos(abs(cone.SemiAngle()))
         rows = max(1, round(slant / h))
         t = slant / rows
-        rim_ang = np.sort(np.arctan2(q[rim] @ ey, q[rim] @ ex) % (2 * math.pi))
+        rim_ang = np.sort(np.arctan2(dot(q[rim], ey), dot(q[rim], ex)) % (2 * math.pi))
         ang = rim_ang
         rho_l, ang_l, row_l = [], [], []
         for j in range(1, rows):
@@ -1062,7 +1064,7 @@ def _meridian(face, o, axis, count: int = 2000):
     g = face._geomAdaptor()
     v = np.linspace(vmin, vmax, count)
     p = np.array([g.Value(umin, x).Coord() for x in v]) - o
-    z = p @ axis
+    z = dot(p, axis)
     rho = np.linalg.norm(p - z[:, None] * axis, axis=1)
     return v, z, rho
 
@@ -1092,7 +1094,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     for f in faces[1:]:
         p, d = revolution_axis(f)
         off = p - o
-        if abs(abs(d @ axis) - 1) > 1e-9 or np.linalg.norm(off - (off @ axis) * axis) > tol:
+        if abs(abs(dot(d, axis)) - 1) > 1e-9 or norm(off - (dot(off, axis)) * axis) > tol:
             return []
     off_axis = np.linalg.norm(np.cross(s.points - o, axis), axis=1) > tol
     if (s.on_feature & off_axis).sum() > len(occ.Vertices()):
@@ -1116,8 +1118,8 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         fi, v, _, _ = parts[k]
         vj = float(np.interp(sj - starts[k], seg[k], v))
         p = np.array(faces[fi]._geomAdaptor().Value(umin[fi], vj).Coord()) - o
-        z = float(p @ axis)
-        return fi, z, float(np.linalg.norm(p - z * axis))
+        z = float(dot(p, axis))
+        return fi, z, float(norm(p - z * axis))
 
     ring = [at(j * t) for j in range(1, rows)]  # (face, axial, radial) per row 1 .. rows - 1
     radial = np.array([r for _, _, r in ring])

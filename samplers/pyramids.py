@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay
 
-from sr33.mesh import triangle_ratios
+from sr33.mesh import dot, norm, triangle_ratios
 
 from .adjacency import EdgeFaces
 from .faces import nearest_face
@@ -79,13 +79,13 @@ class Pyramid:
 
     @property
     def width(self) -> float:
-        return float(np.linalg.norm(self.corners[1] - self.corners[0]))
+        return float(norm(self.corners[1] - self.corners[0]))
 
     @property
     def tan_beta(self) -> float:
         """Tangent of the lateral faces' angle at the base (slant height over half the base)."""
         mid = (self.corners[0] + self.corners[1]) / 2
-        return float(np.linalg.norm(self.apex - mid)) / (self.width / 2)
+        return float(norm(self.apex - mid)) / (self.width / 2)
 
 
 def _vertices(face) -> np.ndarray:
@@ -114,14 +114,14 @@ def find_pyramid(occ, tol: float) -> Pyramid | None:
     normal = np.array(faces[base].normalAt().toTuple())
     others = [q for i in tris for q in _vertices(faces[i])]
     tops = [q for q in others if np.linalg.norm(corners - q, axis=1).min() > tol]
-    if not tops or any(np.linalg.norm(q - tops[0]) > tol for q in tops):
+    if not tops or any(norm(q - tops[0]) > tol for q in tops):
         return None
     apex = tops[0]
     # the base's corners in order round the normal, from the one the face lists first
     ref = corners[0] - centre
     side = np.cross(normal, ref)
     rel = corners - centre
-    order = np.argsort(np.arctan2(rel @ side, rel @ ref) % (2 * math.pi))
+    order = np.argsort(np.arctan2(dot(rel, side), dot(rel, ref)) % (2 * math.pi), kind="stable")
     corners = corners[order]
     sides = np.linalg.norm(np.roll(corners, -1, axis=0) - corners, axis=1)
     diagonals = np.linalg.norm(corners[:2] - corners[2:], axis=1)
@@ -129,7 +129,7 @@ def find_pyramid(occ, tol: float) -> Pyramid | None:
     if (
         np.ptp(sides) > tol
         or abs(diagonals[0] - diagonals[1]) > tol
-        or np.linalg.norm(axis - (axis @ normal) * normal) > tol
+        or norm(axis - (dot(axis, normal)) * normal) > tol
     ):
         return None
     lateral = []
@@ -239,7 +239,7 @@ def lattice_pyramid(occ, s: Samples, h: float, size: float) -> tuple[list[dict],
     for k, fi in enumerate(pyr.lateral):
         a, b = pyr.corners[k], pyr.corners[(k + 1) % 4]
         down = (a + b) / 2 - apex
-        down /= np.linalg.norm(down)
+        down /= norm(down)
         left = edge_face(a, apex)
         ux = (b - a) / pyr.width
         face_pts = [a + np.outer(np.arange(n + 1) * c, ux), apex[None]]
@@ -268,7 +268,7 @@ def lattice_pyramid(occ, s: Samples, h: float, size: float) -> tuple[list[dict],
             face_pts.append(q)
         fp = np.vstack(face_pts)
         uy = -down
-        fb, fw = _worst(np.stack([(fp - a) @ ux, (fp - a) @ uy], axis=1))
+        fb, fw = _worst(np.stack([dot(fp - a, ux), dot(fp - a, uy)], axis=1))
         reports.append(
             {
                 "face": fi,

@@ -20,6 +20,12 @@ Delaunay triangle meets the condition with a margin:
   sample is added at its centroid, whichever helps most after a short local
   descent (candidates in a fixed order, so the result is deterministic);
   bad triangles far apart (``SEPARATION``) are edited in the same round;
+* the descent and the edits are a local search whose end depends on its
+  path; a repair left stuck (a triangle breaking Condition III-ii, ratio
+  at or above √3/2, and ``RETRY_BAD`` or more above its margin) makes
+  further attempts from its input, shaken by seeded offsets
+  (:func:`_attempts`), and keeps the best answer, never one worse than
+  the input;
 * :func:`split_corners`, for a face left with a few bad triangles at a
   fixed corner: a sample added on the corner's bisector, and the repair
   run again.
@@ -30,13 +36,15 @@ plain numpy and scipy's Delaunay; no randomness.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
-from sr33.mesh import SQRT3_2, triangle_ratios
+from sr33.mesh import SQRT3_2, norm, triangle_ratios
+from sr33.progress import log
 
 TARGET = 0.78  # the descent pushes every ratio below this
 BAD = 0.83  # a triangle above this still needs work (margin below sqrt(3)/2)
@@ -51,6 +59,14 @@ IMAGE_BAND = 4.0  # samples this near (times h) a glued side of a development ge
 CORNER_DISTANCES = (0.7, 0.85, 1.0)  # a sample added on a corner's bisector this far, times h
 CORNER_ROUNDS = 4  # corners split one after another, at most this many
 CORNER_REACH = 4.0  # a split's repair moves the free samples this near (times h) the new one
+GOOD_ENOUGH = 0.85  # further attempts (after a first one broke III-ii) end below this
+# ... and with at least this many triangles above the margin: a few in the
+# chart's judged frame are often no violation on the surface, and retrying
+# them traded them for others (conebox: 6 -> 5 in the chart, but 0 -> 3
+# samples violating by the geodesic check)
+RETRY_BAD = 20
+ATTEMPTS = 6  # ... up to this many in all, from the input shaken
+STALL = 16  # ... each ending after this many edits without fewer bad triangles
 _EDGES = np.array([[0, 1], [1, 2], [2, 0]])
 GHOST, FRAME = -1, -2  # the sample id of a ghost point and of a frame point
 
@@ -261,7 +277,7 @@ def _energy(prob: _Problem, subset=None, active=None):
         tri, p, vec, length = tri[near], p[near], vec[near], length[near]
     if tri.shape[0] == 0:
         return 0.0, grad, np.empty(0), tri, p
-    order = np.argsort(length, axis=1)
+    order = np.argsort(length, axis=1, kind="stable")
     rows = np.arange(tri.shape[0])
     i2, i3 = order[:, 1], order[:, 2]
     l2, l3 = length[rows, i2], length[rows, i3]
@@ -510,14 +526,38 @@ def repair(
         wide,
         None if anchors is None else np.asarray(anchors, dtype=bool)[sub],
     )
-    _descend(prob, descent_steps)
-    nbad, _, bad, worst = _status(prob)
     if max_edits is None:
         max_edits = max(80, int(movable.sum()) // 8)
+    searching = descent_steps > 0 or max_edits > 0
+    start = prob.copy() if searching else prob
+    prob, nbad, worst = _search(prob, descent_steps, max_edits)
+    if searching and worst >= SQRT3_2 and nbad >= RETRY_BAD:
+        prob, nbad, worst = _attempts(start, (prob, nbad, worst), descent_steps, max_edits)
+    # put the frame back among the untouched samples
+    rest = np.setdiff1d(np.arange(n), sub)
+    origin = np.where(prob.origin >= 0, sub[np.maximum(prob.origin, 0)], -1)
+    return Repaired(
+        uv=np.vstack([uv[rest], prob.uv]),
+        origin=np.concatenate([rest, origin]),
+        bad=nbad,
+        worst=worst,
+    )
+
+
+def _search(
+    prob: _Problem, descent_steps: int, max_edits: int, stall: float = math.inf
+) -> tuple[_Problem, int, float]:
+    """One attempt of :func:`repair`: a descent, then edits round the bad
+    triangles until none is left, the edits run out, or ``stall`` edits
+    pass without fewer bad triangles.  Returns the state, its bad triangles
+    and its worst ratio."""
+    _descend(prob, descent_steps)
+    nbad, _, bad, worst = _status(prob)
     edits = 0
     skip: set[tuple] = set()
     cleared_at = 0
-    while nbad and edits < max_edits:
+    fewest, since = nbad, 0
+    while nbad and edits < max_edits and since < stall:
         regions = _regions(prob, bad, skip)
         if not regions:
             if edits == cleared_at:
@@ -537,15 +577,57 @@ def repair(
         centres = [c for _, c in chosen]
         _descend(prob, 60, *_union(prob, centres, 8.0), centres=centres)
         nbad, _, bad, worst = _status(prob)
-    # put the frame back among the untouched samples
-    rest = np.setdiff1d(np.arange(n), sub)
-    origin = np.where(prob.origin >= 0, sub[np.maximum(prob.origin, 0)], -1)
-    return Repaired(
-        uv=np.vstack([uv[rest], prob.uv]),
-        origin=np.concatenate([rest, origin]),
-        bad=nbad,
-        worst=worst,
+        fewest, since = (nbad, 0) if nbad < fewest else (fewest, since + len(chosen))
+    return prob, nbad, worst
+
+
+def _rank(answer) -> tuple:
+    """How :func:`_attempts` ranks answers ``(state, bad, worst)``: first whether
+    a triangle breaks Condition III-ii; among those that do, the worst ratio
+    (how far it is broken), then the bad triangles; among those that do not,
+    the triangles above the margin, then the worst.  Ratios are compared
+    rounded to 1e-6, so that a last-bit difference cannot reorder them."""
+    _, nbad, worst = answer
+    w = round(float(worst), 6)
+    return (True, w, nbad) if worst >= SQRT3_2 else (False, nbad, w)
+
+
+def _attempts(start: _Problem, first, descent_steps: int, max_edits: int):
+    """Further attempts after a first one left a triangle breaking III-ii
+    (ratio at or above √3/2): the descent and the edits are a local search whose end
+    depends on its path (the last bits of the input can decide it), so the
+    search starts again from the input with its free samples shaken by
+    seeded offsets (attempt a: up to 0.03 a h, uniform in a square), each
+    ending after ``STALL`` edits without progress.  The best answer by
+    :func:`_rank` is kept, the input itself among them (never worse than
+    it), and the attempts end once one is below ``GOOD_ENOUGH``."""
+    nbad, _, _, worst = _status(start)
+    best = min((first, (start, nbad, worst)), key=_rank)
+    for attempt in range(1, ATTEMPTS):
+        if best[2] < GOOD_ENOUGH:
+            break
+        trial = start.copy()
+        _shake(trial, attempt)
+        answer = _search(trial, descent_steps, max_edits, STALL)
+        best = min((best, answer), key=_rank)
+    log.debug(
+        "repair attempts: first %d bad (worst %.3f), kept %d bad (worst %.3f)",
+        first[1], first[2], best[1], best[2],
     )
+    return best
+
+
+def _shake(prob: _Problem, attempt: int) -> None:
+    """Move the free samples by the seeded offsets of ``attempt`` (uniform in
+    a square of half-side 0.03 ``attempt`` h: the same on every machine)."""
+    rng = np.random.default_rng(attempt)
+    free = np.flatnonzero(prob.free)
+    size = 0.03 * attempt * prob.h
+    prob.uv[free] += (rng.random((free.size, 2)) * 2.0 - 1.0) * size
+    if prob.clamp is not None and free.size:
+        prob.uv[free] = prob.clamp(prob.uv[free])
+    if prob.turn is not None and free.size:
+        prob.uv[free] = prob.wrap(prob.uv[free])
 
 
 def _edited(prob: _Problem, edits) -> _Problem:
@@ -652,8 +734,8 @@ def _corner_wedge(r: Repaired, fixed: np.ndarray, inside) -> tuple[int, np.ndarr
             v = int(tri[t, k])
             if fixed[v]:
                 a, b = r.uv[tri[t, (k + 1) % 3]] - r.uv[v], r.uv[tri[t, (k + 2) % 3]] - r.uv[v]
-                half = a / np.linalg.norm(a) + b / np.linalg.norm(b)
-                return v, half / np.linalg.norm(half)
+                half = a / norm(a) + b / norm(b)
+                return v, half / norm(half)
     return None
 
 

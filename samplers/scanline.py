@@ -67,7 +67,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
-from sr33.mesh import surface_points
+from sr33.mesh import dot, norm, surface_points
 from sr33.progress import bar, log, timed
 
 from .adjacency import EdgeFaces
@@ -192,7 +192,8 @@ def _face_family(face, dirs: np.ndarray, tol: float) -> int:
     if not keep.any():
         return 0
     n = cr[keep] / area[keep][:, None]
-    score = (np.abs(n @ dirs.T) * area[keep][:, None]).sum(axis=0) / area[keep].sum()
+    score = (np.abs(dot(n[:, None, :], dirs[None, :, :])) * area[keep][:, None]).sum(axis=0)
+    score /= area[keep].sum()
     best = float(score.min())
     return int(np.flatnonzero(score <= best + 1e-9)[0])
 
@@ -239,16 +240,16 @@ def _chains(edges, tol: float) -> list[tuple[list[tuple[Any, bool]], bool]]:
             grown = False
             for i, e in enumerate(remaining):
                 s, t = ends[id(e)]
-                if np.linalg.norm(s - tail) <= tol:
+                if norm(s - tail) <= tol:
                     chain.append((e, False))
                     tail = t
-                elif np.linalg.norm(t - tail) <= tol:
+                elif norm(t - tail) <= tol:
                     chain.append((e, True))
                     tail = s
-                elif np.linalg.norm(t - head) <= tol:
+                elif norm(t - head) <= tol:
                     chain.insert(0, (e, False))
                     head = s
-                elif np.linalg.norm(s - head) <= tol:
+                elif norm(s - head) <= tol:
                     chain.insert(0, (e, True))
                     head = t
                 else:
@@ -256,7 +257,7 @@ def _chains(edges, tol: float) -> list[tuple[list[tuple[Any, bool]], bool]]:
                 remaining.pop(i)
                 grown = True
                 break
-        closed = bool(np.linalg.norm(head - tail) <= tol)
+        closed = bool(norm(head - tail) <= tol)
         chains.append((chain, closed))
     return chains
 
@@ -320,7 +321,7 @@ def _sample_chain(
         e = chain[0][0]
         a = np.array(e.startPoint().toTuple())
         b = np.array(e.endPoint().toTuple())
-        length = float(np.linalg.norm(b - a))
+        length = float(norm(b - a))
         u = (b - a) / length
         aligned = True
         if axis_steps is not None:
@@ -331,14 +332,16 @@ def _sample_chain(
             if k is not None:
                 step = float(axis_steps[k])
             else:
-                par = [(ea, es) for ea, eu, es in edge_lattices if abs(abs(eu @ u) - 1.0) < 1e-9]
+                par = [
+                    (ea, es) for ea, eu, es in edge_lattices if abs(abs(dot(eu, u)) - 1.0) < 1e-9
+                ]
                 if par:
                     mid = (a + b) / 2
-                    off = [np.linalg.norm((mid - ea) - ((mid - ea) @ u) * u) for ea, _ in par]
+                    off = [norm((mid - ea) - (dot(mid - ea, u)) * u) for ea, _ in par]
                     anchor, es = par[int(np.argmin(off))]
                     step = ratio * es
                     aligned = False
-        c0 = float((a - anchor) @ u)
+        c0 = float(dot(a - anchor, u))
         first = math.ceil(c0 / step - 1e-9)
         last = math.floor((c0 + length) / step + 1e-9)
         s = np.arange(first, last + 1) * step - c0
@@ -405,14 +408,14 @@ def _sphere_row(chain, step: float, sphere) -> np.ndarray:
     lengths = np.array([e.Length() for e, _ in chain])
     starts = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
     mid = _chain_point(chain, lengths, starts, float(lengths.sum()) / 2)
-    cc = centre + float((ends[0] - centre) @ d) * d
-    r = float(np.linalg.norm(ends[0] - cc))
+    cc = centre + float(dot(ends[0] - centre, d)) * d
+    r = float(norm(ends[0] - cc))
     if r < 1e-12:
         return np.array(ends)
 
     def angle(p):
         q = p - cc
-        return math.atan2(float(q @ e2), float(q @ e1))
+        return math.atan2(float(dot(q, e2)), float(dot(q, e1)))
 
     a0, am, a1 = angle(ends[0]), angle(mid), angle(ends[1])
     span = (a1 - a0) % (2 * math.pi)
@@ -446,7 +449,7 @@ def _plane_offsets(lo: float, hi: float, t0: float, hf: float, sphere=None) -> n
         j1 = math.floor((hi - t0) / hf + 1e-9)
         return t0 + np.arange(j0, j1 + 1) * hf
     centre, radius, _, _, d = sphere
-    c = float(centre @ d)
+    c = float(dot(centre, d))
     psi = np.arccos(np.clip((c - np.array([lo, hi])) / radius, -1.0, 1.0))  # grows with t
     step = hf / radius
     k = np.arange(math.ceil(psi[0] / step - 1e-9), math.floor(psi[1] / step + 1e-9) + 1)
@@ -483,20 +486,20 @@ def _columns(face, d, hf, ratio, anchor, axis_steps):
     if face.geomType() != "PLANE":
         return None
     rows = np.cross(np.array(face.normalAt().toTuple()), d)
-    if np.linalg.norm(rows) < 1e-9:
+    if norm(rows) < 1e-9:
         return None
-    rows /= np.linalg.norm(rows)
+    rows /= norm(rows)
     for e in face.Edges():
         if e.geomType() == "LINE":
             t = np.array(e.endPoint().toTuple()) - np.array(e.startPoint().toTuple())
-            if abs(abs(float(t @ rows)) - np.linalg.norm(t)) <= 1e-9 * np.linalg.norm(t):
+            if abs(abs(float(dot(t, rows))) - norm(t)) <= 1e-9 * norm(t):
                 return None
     k = _axis_index(rows)
     if k is not None:
         axis = np.zeros(3)
         axis[k] = 1.0
         return axis, float(anchor[k]), float(axis_steps[k])
-    return rows, float(anchor @ rows), ratio * hf
+    return rows, float(dot(anchor, rows)), ratio * hf
 
 
 def _row_crossings(a, u, length, adjacent, faces, planes, step):
@@ -526,18 +529,18 @@ def _row_crossings(a, u, length, adjacent, faces, planes, step):
         if along is None or along < 1e-6 or along > 1 - 1e-6:
             continue  # rows parallel or perpendicular to the edge: equal steps fit
         for normal, offset, gap in [(d, t0, hf)] + ([columns] if columns else []):
-            un = float(u @ normal)
+            un = float(dot(u, normal))
             if abs(un) < 1e-9:
                 continue
             spacing = gap / abs(un)
             if spacing > SLANT_STEP * step or (best is not None and spacing >= best[0] - 1e-12):
                 continue
-            ends = sorted((float(a @ normal), float((a + length * u) @ normal)))
+            ends = sorted((float(dot(a, normal)), float(dot(a + length * u, normal))))
             j = np.arange(
                 math.ceil((ends[0] - offset) / gap - 1e-9),
                 math.floor((ends[1] - offset) / gap + 1e-9) + 1,
             )
-            lattice = np.sort((offset + j * gap - float(a @ normal)) / un)
+            lattice = np.sort((offset + j * gap - float(dot(a, normal))) / un)
             if lattice.size:
                 best = (spacing, _even_ends(lattice, length, FEATURE_CLEARANCE * step), lattice[0])
     if best is None or best[1].size == 0:
@@ -575,7 +578,7 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
             mid = edge.positionAt(0.5, mode="length")
             n1 = np.array(uniq[0].normalAt(mid).toTuple())
             n2 = np.array(uniq[1].normalAt(mid).toTuple())
-            if float(n1 @ n2) > cos_lim:
+            if float(dot(n1, n2)) > cos_lim:
                 continue  # smooth edge (fillet tangency) or seam: sampled by scan lines
         elif len(uniq) != 1 or uses != 1:
             continue  # a seam edge (one face on both sides): sampled by scan lines
@@ -705,7 +708,7 @@ def scan(
         raise SamplingError("shape has no faces to sample")
     with bar(len(faces) + 2 + (8 if repair else 0), "sample", quiet, unit="step") as pbar:
         lo, hi = exact_bounds(occ)
-        size = float(np.linalg.norm(hi - lo))
+        size = float(norm(hi - lo))
         area = float(sum(f.Area() for f in faces))
         if spacing is not None:
             h = float(spacing)
@@ -727,10 +730,10 @@ def scan(
         planes = []  # per face: its family's direction, first plane, spacing, columns
         for fi, face in enumerate(faces):
             d = dirs[fam[fi]]
-            t0 = float((corner @ d).min())
+            t0 = float((dot(corner, d)).min())
             # the family's spacing divides the shape's extent along d, so the
             # last plane meets the far side as the first meets the near side
-            hf = _dividing_step(float((corner @ d).max()) - t0, h)
+            hf = _dividing_step(float((dot(corner, d)).max()) - t0, h)
             planes.append((d, t0, hf, _columns(face, d, hf, ratio, lo, axis_steps)))
         with timed("sample: feature samples"):
             pts, fids, feature_curve, lattices = _feature_samples(
@@ -746,7 +749,7 @@ def scan(
             pbar.update(1)
             d, t0, hf, _ = planes[fi]
             sphere = _sphere_frame(face, d)
-            proj = _box_corners(*exact_bounds(face)) @ d
+            proj = dot(_box_corners(*exact_bounds(face)), d)
             rimmed = sphere is not None and rims_sampled(face, feature_pts, h)
             for t in _plane_offsets(proj.min(), proj.max(), t0, hf, sphere if rimmed else None):
                 origin = d * t

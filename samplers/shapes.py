@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from sr33.mesh import edge_uses, half_edges, unique_rows
+from sr33.mesh import edge_uses, half_edges, norm, unique_rows
 
 MESH_TOLERANCE = 1.0 / 500.0  # linear deflection of the truth mesh, times the size
 MESH_ANGULAR = 0.1  # angular deflection of the truth mesh, radians
@@ -884,7 +884,7 @@ def _exact_size(solid) -> float:
     BRepBndLib.AddOptimal_s(solid.wrapped, box, False, False)
     lo = np.array(box.Get()[:3])
     hi = np.array(box.Get()[3:])
-    return float(np.linalg.norm(hi - lo))
+    return float(norm(hi - lo))
 
 
 # ---------------------------------------------------------------------------

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from sr33.mesh import SQRT3_2
+from sr33.mesh import SQRT3_2, dot, norm
 
 from .chart import Arc, Raster, arc_clamp, arc_sides, segment_distance
 from .faces import boundary_segments, goes_round, perpendicular, rims_sampled
@@ -48,8 +48,9 @@ class _Stereographic:
 
     def __call__(self, p) -> np.ndarray:
         u = (np.asarray(p, dtype=np.float64) - self.centre) / self.radius
-        den = 1.0 + u @ self.pole
-        return 2.0 * self.radius * np.stack([u @ self.e1, u @ self.e2], axis=1) / den[:, None]
+        den = 1.0 + dot(u, self.pole)
+        uv = np.stack([dot(u, self.e1), dot(u, self.e2)], axis=1)
+        return 2.0 * self.radius * uv / den[:, None]
 
     def inverse(self, q: np.ndarray) -> np.ndarray:
         x = q / (2.0 * self.radius)
@@ -67,11 +68,11 @@ def _circle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, fl
     scale = max(np.ptp(np.stack([a, b, c]), axis=0).max(), 1e-300)
     if abs(d) < 1e-9 * scale**2:
         return None
-    sa, sb, sc = a @ a, b @ b, c @ c
+    sa, sb, sc = dot(a, a), dot(b, b), dot(c, c)
     ux = (sa * (b[1] - c[1]) + sb * (c[1] - a[1]) + sc * (a[1] - b[1])) / d
     uy = (sa * (c[0] - b[0]) + sb * (a[0] - c[0]) + sc * (b[0] - a[0])) / d
     centre = np.array([ux, uy])
-    return centre, float(np.linalg.norm(a - centre))
+    return centre, float(norm(a - centre))
 
 
 def _rim_arcs(face, to2d) -> list[Arc] | None:
@@ -114,7 +115,7 @@ def _rim_frame(face, arcs, sides, to2d: _Stereographic, s: Samples, own, h: floa
         rr = float(circ.Radius())
         x = s.points[others]
         w = x - cc
-        w -= np.outer(w @ nn, nn)
+        w -= np.outer(dot(w, nn), nn)
         norm = np.linalg.norm(w, axis=1)
         ok = norm > 1e-12 * rr
         y = cc + rr * w[ok] / norm[ok, None]  # the nearest point of the rim's circle
@@ -195,11 +196,11 @@ def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=N
     centre = np.array(sph.Location().Coord())
     radius = float(sph.Radius())
     pole = np.array(face.Center().toTuple()) - centre
-    if np.linalg.norm(pole) < 1e-9 * radius:
+    if norm(pole) < 1e-9 * radius:
         return None
-    pole /= np.linalg.norm(pole)
+    pole /= norm(pole)
     verts, _ = face.tessellate(h / 20, 0.3)
-    reach = (np.array([v.toTuple() for v in verts]) - centre) @ pole
+    reach = dot(np.array([v.toTuple() for v in verts]) - centre, pole)
     if reach.min() <= FACING * radius:
         return None  # the face wraps too far round for one map
     to2d = _Stereographic(centre, radius, pole)
@@ -208,7 +209,7 @@ def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=N
         return None
     q = s.points - centre
     dist = np.linalg.norm(q, axis=1)
-    cand = np.flatnonzero((np.abs(dist - radius) < tol) & (q @ pole > FACING * radius))
+    cand = np.flatnonzero((np.abs(dist - radius) < tol) & (dot(q, pole) > FACING * radius))
     uv = to2d(s.points[cand])
     seg = boundary_segments(face, to2d, h / 20)
     raster = Raster(seg, h / RASTER)

@@ -15,6 +15,7 @@ they do it here.  Plain numpy and scipy; arrays in, arrays out (points
 * :func:`self_intersections`: pairs of triangles whose interiors meet.
 * :func:`closest_points_on_triangles`: Ericson's region test, vectorized.
 * :func:`triangle_ratios` and ``SQRT3_2``: Condition III-ii of the paper.
+* :func:`dot`, :func:`norm`: products whose bits do not depend on the machine.
 * :func:`surface_points`: area-uniform points on a triangle mesh.
 """
 
@@ -27,6 +28,30 @@ from scipy import sparse
 from scipy.sparse import csgraph
 
 SQRT3_2 = float(np.sqrt(3.0) / 2.0)  # Condition III-ii: shorter edges below this times the longest
+
+
+def dot(a, b) -> np.ndarray:
+    """Dot products along the last axis, the same bits on every machine.
+
+    ``a @ b`` and ``np.linalg.norm(v)`` call BLAS, whose kernels (chosen by
+    the CPU: FMA or not, SIMD width) sum in different orders, so their last
+    bits differ between machines; an iterative layout or a tie amplifies
+    that into a different result.  Here every product is rounded on its own
+    and the sum runs left to right (IEEE arithmetic, no BLAS).
+
+    Examples
+    --------
+    >>> float(dot([1.0, 2.0, 3.0], [4.0, 5.0, 6.0]))
+    32.0
+    >>> dot([[1.0, 0.0], [0.0, 2.0]], [3.0, 4.0]).tolist()
+    [3.0, 8.0]
+    """
+    return (np.asarray(a, dtype=np.float64) * np.asarray(b, dtype=np.float64)).sum(axis=-1)
+
+
+def norm(v) -> np.ndarray:
+    """Euclidean length along the last axis, by :func:`dot` (no BLAS)."""
+    return np.sqrt(dot(v, v))
 
 
 def edge_keys(a, b, n: int) -> np.ndarray:

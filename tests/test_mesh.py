@@ -1,0 +1,114 @@
+"""sr33.mesh: the shared primitives against slow, obviously correct references."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from sr33.mesh import (
+    dot,
+    edge_incidence,
+    edge_uses,
+    half_edges,
+    norm,
+    orientation_double_cover,
+    triangle_ratios,
+    unique_edges,
+    unique_rows,
+)
+
+triangles = st.lists(
+    st.lists(st.integers(0, 7), min_size=3, max_size=3, unique=True), min_size=1, max_size=12
+)
+
+
+@given(
+    arrays(np.int64, st.tuples(st.integers(0, 30), st.integers(1, 4)), elements=st.integers(0, 9))
+)
+def test_unique_rows_is_numpys_unique(a):
+    got, counts = unique_rows(a, return_counts=True)
+    want, wcounts = np.unique(a, axis=0, return_counts=True)
+    assert np.array_equal(got, want.reshape(-1, a.shape[1]))
+    assert np.array_equal(counts, wcounts)
+
+
+def test_unique_rows_refuses_other_than_two_dimensions():
+    with pytest.raises(ValueError, match=r"rows must be a 2-D array, got shape \(3,\)"):
+        unique_rows([1, 2, 3])
+
+
+@given(triangles)
+def test_edge_incidence_matches_counting_by_hand(tris):
+    t = np.array(tris)
+    uses: dict[tuple[int, int], list[tuple[int, bool]]] = {}
+    for f, (a, b, c) in enumerate(tris):
+        for p, q in ((a, b), (b, c), (c, a)):
+            uses.setdefault((min(p, q), max(p, q)), []).append((f, p < q))
+    inc = edge_incidence(*half_edges(t))
+    assert [tuple(e) for e in inc.edges.tolist()] == sorted(uses)
+    assert inc.counts.tolist() == [len(uses[k]) for k in sorted(uses)]
+    e, c = edge_uses(t)
+    assert np.array_equal(e, inc.edges) and np.array_equal(c, inc.counts)
+    # every half-edge points at its own edge
+    pairs, owner = half_edges(t)
+    assert np.array_equal(np.sort(pairs, axis=1), inc.edges[inc.edge_of])
+    assert np.array_equal(owner, inc.face)
+    # the manifold pairs: exactly the edges of two uses, coherent when opposite
+    edge, fa, fb, coherent = inc.manifold_pairs()
+    want = {k: v for k, v in uses.items() if len(v) == 2}
+    got = {tuple(inc.edges[i]): (a, b, ok) for i, a, b, ok in zip(edge, fa, fb, coherent)}
+    assert set(got) == set(want)
+    for k, (a, b, ok) in got.items():
+        (f0, d0), (f1, d1) = want[k]
+        assert {a, b} == {f0, f1} and ok == (d0 != d1)
+    # shared(): k - 1 consecutive pairs per edge of k uses
+    assert inc.shared()[0].size == sum(len(v) - 1 for v in uses.values())
+
+
+def test_orientation_double_cover_tells_a_moebius_strip_from_an_annulus():
+    # a strip of 4 triangles closed with a twist: its last link crosses
+    fa, fb = [0, 1, 2, 3], [1, 2, 3, 0]
+    twisted = orientation_double_cover(4, fa, fb, [True, True, True, False])
+    assert twisted[0] == twisted[4]  # a face and its flip in one component: non-orientable
+    plain = orientation_double_cover(4, fa, fb, [True, True, True, True])
+    assert plain[0] != plain[4]
+
+
+@given(arrays(np.float64, (5, 3), elements=st.floats(-10, 10)))
+def test_dot_and_norm_are_the_plain_sums_of_products(a):
+    b = a[::-1]
+    want = np.array([sum(x * y for x, y in zip(r, s)) for r, s in zip(a, b)])
+    assert np.array_equal(dot(a, b), want)  # left to right, each product rounded: no FMA
+    np.testing.assert_allclose(norm(a), np.sqrt((a * a).sum(axis=1)), rtol=1e-15)
+
+
+def test_triangle_ratios_of_known_triangles():
+    p = np.array([[0, 0], [1, 0], [0, 1], [0.5, np.sqrt(3) / 2], [2, 0], [0, 1.0]])
+    r = triangle_ratios(p, [(0, 1, 2), (0, 1, 3), (0, 4, 5)])
+    np.testing.assert_allclose(r, [1 / np.sqrt(2), 1.0, 2 / np.sqrt(5)])
+    assert r[0] < np.sqrt(3) / 2 < r[1]
+
+
+@given(arrays(np.float64, (4, 3), elements=st.floats(-3, 3)))
+def test_closest_point_beats_a_dense_sampling_of_the_triangle(q):
+    from sr33.mesh import closest_points_on_triangles
+
+    p, tri = q[0], q[1:]
+    if np.linalg.norm(np.cross(tri[1] - tri[0], tri[2] - tri[0])) < 1e-3:
+        return  # (nearly) degenerate: nothing to compare with
+    d2, w = closest_points_on_triangles(p[None], tri[None])
+    assert np.all(w >= -1e-9) and abs(w.sum() - 1) < 1e-9
+    np.testing.assert_allclose(((w @ tri - p) ** 2).sum(), d2[0], rtol=1e-9, atol=1e-12)
+    s = np.linspace(0, 1, 41)
+    grid = np.array([(a, b) for a, b in itertools.product(s, s) if a + b <= 1])
+    pts = tri[0] + grid[:, :1] * (tri[1] - tri[0]) + grid[:, 1:] * (tri[2] - tri[0])
+    assert d2[0] <= ((pts - p) ** 2).sum(axis=1).min() + 1e-12
+
+
+def test_unique_edges_sorts_each_pair():
+    assert unique_edges([[3, 1], [1, 3], [0, 2]]).tolist() == [[0, 2], [1, 3]]
