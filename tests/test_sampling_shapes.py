@@ -18,8 +18,15 @@ QUICK = {"cube", "L_sheet", "pyramid", "square_ring", "box_hole", "cylinder", "f
 
 
 def by_speed(names):
-    """``names`` as parameters, those not in QUICK marked slow."""
-    return [n if n in QUICK else pytest.param(n, marks=pytest.mark.slow) for n in names]
+    """``names`` as parameters, those not in QUICK marked slow; each in the
+    xdist group of its shape, so that ``--dist loadgroup`` (``make check``)
+    samples a shape once, on one worker, and spreads the shapes."""
+    return [
+        pytest.param(
+            n, marks=[pytest.mark.xdist_group(n)] + ([] if n in QUICK else [pytest.mark.slow])
+        )
+        for n in names
+    ]
 
 
 class _Samplings(dict):
