@@ -34,3 +34,52 @@ def test_no_strays_returns_a_copy():
 def test_empty_surface_is_an_error():
     with pytest.raises(InputError, match="triangles is empty"):
         attach_cones(TETRA_PTS, np.empty((0, 3), int))
+
+
+def _bevelled_roof(angle_deg, n=12, rows=4):
+    """Two planar faces meeting at a sharp edge of ``angle_deg`` (dihedral),
+    rows h apart on each face, the edge's own samples left stray and the two
+    first rows joined across the edge by chords: the bevel a closed selection
+    makes at an acute edge (issue 21)."""
+    a = np.radians(angle_deg) / 2
+    faces = {"A": np.array([0, np.sin(a), np.cos(a)]), "B": np.array([0, -np.sin(a), np.cos(a)])}
+    idx, pts = {}, []
+    for side, d in faces.items():
+        for j in range(1, rows + 1):
+            for i in range(n):
+                idx[side, i, j] = len(pts)
+                pts.append(np.array([i + 0.5 * (j % 2), 0, 0]) + j * d)
+    ridge = []
+    for i in range(n):
+        ridge.append(len(pts))
+        pts.append(np.array([i + 0.5, 0, 0]))
+    tri = []
+    for side in "AB":
+        for j in range(1, rows):
+            for i in range(n - 1):
+                a_, b_ = idx[side, i, j], idx[side, i + 1, j]
+                c_, d_ = idx[side, i, j + 1], idx[side, i + 1, j + 1]
+                tri += [(a_, b_, d_), (a_, d_, c_)] if side == "A" else [(a_, d_, b_), (a_, c_, d_)]
+    for i in range(n - 1):
+        a_, b_ = idx["A", i, 1], idx["A", i + 1, 1]
+        c_, d_ = idx["B", i, 1], idx["B", i + 1, 1]
+        tri += [(a_, d_, b_), (a_, c_, d_)]
+    return np.array(pts), np.array(tri), ridge
+
+
+@pytest.mark.parametrize("angle", [20.0, 40.0, 60.0, 90.0])
+def test_cones_on_a_bevel_are_flipped_back_to_the_sharp_edge(angle):
+    """The stray samples of a bevelled sharp edge, coned on and flipped for
+    the least total absolute curvature, lie on one line of edges again, with
+    no two triangles crossing (cones alone: tents that cross)."""
+    from sr33.mesh import half_edges, self_intersections, unique_edges
+
+    pts, tri, ridge = _bevelled_roof(angle)
+    tents, _ = attach_cones(pts, tri, flips=False)
+    out, strays = attach_cones(pts, tri)
+    assert sorted(strays.tolist()) == ridge
+    assert self_intersections(pts, tents).shape[0] > 0
+    assert self_intersections(pts, out).shape[0] == 0
+    edges = {tuple(e) for e in unique_edges(half_edges(out)[0]).tolist()}
+    assert all((a, b) in edges for a, b in zip(ridge[:-1], ridge[1:]))
+    assert out.shape[0] == tents.shape[0]
