@@ -277,3 +277,33 @@ def test_split_corners_mends_an_angle_the_edits_cannot():
     assert np.array_equal(split.uv[kept], uv[split.origin[kept]])
     again = split_corners(uv, free, 1.0, first, inside=inside)
     assert np.array_equal(again.uv, split.uv) and np.array_equal(again.origin, split.origin)
+
+
+def test_a_stuck_repair_is_retried_and_never_ends_worse(monkeypatch):
+    """A repair left stuck (edits cut short here) starts again from its input
+    shaken by seeded offsets and keeps the best answer: never worse than the
+    single attempt, and the same on every run (the offsets are seeded)."""
+    import sr33.samplers.repair as rp
+
+    h, radius, c = 0.05, 0.25, np.array([0.01, 0.02])
+    uv, on_rim = hole_layout(h, radius, c)
+    free = ~on_rim & (np.linalg.norm(uv - c, axis=1) < radius + 2.5 * h)
+
+    def project(q):
+        w = q - c
+        return c + radius * w / np.linalg.norm(w, axis=1)[:, None]
+
+    def inside(q):
+        return np.linalg.norm(q - c, axis=1) > radius
+
+    kw = dict(slide=on_rim, project=project, inside=inside, descent_steps=2, max_edits=1)
+    monkeypatch.setattr(rp, "ATTEMPTS", 1)
+    single = repair(uv, free, h, **kw)
+    assert single.worst >= np.sqrt(3) / 2  # stuck: the case the attempts are for
+    monkeypatch.setattr(rp, "ATTEMPTS", 6)
+    monkeypatch.setattr(rp, "RETRY_BAD", 1)
+    retried = repair(uv, free, h, **kw)
+    rank = lambda r: rp._rank((None, r.bad, r.worst))  # noqa: E731
+    assert rank(retried) <= rank(single)
+    again = repair(uv, free, h, **kw)
+    np.testing.assert_array_equal(again.uv, retried.uv)
