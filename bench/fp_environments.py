@@ -125,20 +125,21 @@ def figures(name: str, path: Path) -> dict:
     rec = reconstruct(p, 33)
     st = mesh_stats(rec.triangles, rec.vertices.shape[0])
     e = s.expected
+    violating = int(np.count_nonzero(~(cond.worst_ratio < SQRT3_2)))
+    cover = float(cKDTree(p).query(dense)[0].max())
+    closest = float(d[:, 1].min())
     return {
         "points": int(p.shape[0]),
         "iii_worst": round(float(cond.max_ratio), 3),
-        "iii_violating": int(np.count_nonzero(~(cond.worst_ratio < SQRT3_2))),
+        "iii_violating": violating,
         "max_degree": int(cond.max_degree),
-        "coverage_h": round(float(cKDTree(p).query(dense)[0].max() / h), 2),
-        "closest_h": round(float(d[:, 1].min() / h), 2),
+        "coverage_h": round(cover / h, 2),
+        "closest_h": round(closest / h, 2),
         "open": int(st.open_edges),
         "overloaded": int(st.overloaded_edges),
         "euler": int(st.euler),
         "conforms": bool(
-            np.count_nonzero(~(cond.worst_ratio < SQRT3_2)) == 0
-            and cKDTree(p).query(dense)[0].max() <= 1.5 * h
-            and d[:, 1].min() >= 0.25 * h
+            violating == 0 and cover <= 1.5 * h and closest >= 0.25 * h
         ),
         "topology_ok": bool(
             st.overloaded_edges == 0

@@ -593,11 +593,12 @@ def _rank(answer) -> tuple:
 
 
 def _attempts(start: _Problem, first, descent_steps: int, max_edits: int):
-    """Further attempts after a first one left a triangle breaking III-ii
-    (ratio at or above √3/2): the descent and the edits are a local search whose end
-    depends on its path (the last bits of the input can decide it), so the
-    search starts again from the input with its free samples shaken by
-    seeded offsets (attempt a: up to 0.03 a h, uniform in a square), each
+    """Further attempts after a first one was left stuck (a triangle
+    breaking III-ii and ``RETRY_BAD`` or more above the margin): the
+    descent and the edits are a local search whose end depends on its path
+    (the last bits of the input can decide it), so the search starts again
+    from the input with its free samples shaken by seeded offsets (attempt
+    a: up to 0.03 a h, uniform in a square), each
     ending after ``STALL`` edits without progress.  The best answer by
     :func:`_rank` is kept, the input itself among them (never worse than
     it), and the attempts end once one is below ``GOOD_ENOUGH``."""

@@ -22,7 +22,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ._validate import InputError, as_points
-from .mesh import closest_points_on_triangles, half_edges, norm, self_intersections, unique_rows
+from .mesh import (
+    closest_points_on_triangles,
+    dot,
+    half_edges,
+    norm,
+    self_intersections,
+    unique_rows,
+)
 
 
 def ring_centres(points, faces) -> dict[int, int]:
@@ -156,7 +163,7 @@ def _turn(points, t1, t2) -> float:
     n1, n2 = _normal(points, t1), _normal(points, t2)
     if not n1.any() or not n2.any():
         return np.pi
-    return float(np.arccos(np.clip(float(n1 @ n2), -1.0, 1.0)))
+    return float(np.arccos(np.clip(float(dot(n1, n2)), -1.0, 1.0)))
 
 
 def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:

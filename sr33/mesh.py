@@ -37,7 +37,8 @@ def dot(a, b) -> np.ndarray:
     the CPU: FMA or not, SIMD width) sum in different orders, so their last
     bits differ between machines; an iterative layout or a tie amplifies
     that into a different result.  Here every product is rounded on its own
-    and the sum runs left to right (IEEE arithmetic, no BLAS).
+    and summed by numpy's own reduction, whose order is fixed by the array's
+    length, not by the CPU (no BLAS).
 
     Examples
     --------
