@@ -62,6 +62,7 @@ from .graph import cycle_edges, lookup_edges
 from .mesh import self_intersections, unique_edges, unique_rows
 from .progress import bar
 from .rng import Neighbourhoods, k_neighbourhoods
+from .selection import ExactReport, exact_selection
 from .tolerance import DEFAULT, Tolerance
 
 
@@ -76,9 +77,10 @@ class FaceSelection:
     selected : (c,) bool
         Which input cycles were selected.
     success : bool
-        True when the success condition held: no edge used more than twice,
-        every used sample's link a disk, no sample left without a face, and
-        no component needed the greedy fallback.
+        True when the paper's success condition held: no edge used more
+        than twice, every used sample's link a disk, and open edges only on
+        true boundaries (edges lying in one candidate cycle).  Stray samples
+        (no face uses them) are allowed; the cones attach them (Section 5).
     open_edges : (p, 2) int64
         Edges of the selection used once (the boundary; empty when closed).
     unresolved_samples : (q,) int64
@@ -86,7 +88,8 @@ class FaceSelection:
     components : int
         Number of independent ambiguous components searched.
     fallback_components : int
-        How many of them fell back to the greedy pass.
+        How many of them the strict search could not solve (they fell back
+        to the greedy pass, then to the exact selection).
     assignments : int
         Total search assignments made (a measure of the work done).
     non_disk_neighbourhoods : (r,) int64
@@ -99,6 +102,9 @@ class FaceSelection:
         hull would cover.
     notes : tuple of str
         Human-readable remarks (overloaded edges, empty input).
+    exact : ExactReport
+        What the exact selection (:mod:`sr33.selection`) did on the
+        components the strict search failed.
     """
 
     faces: CycleSet
@@ -111,6 +117,7 @@ class FaceSelection:
     assignments: int
     non_disk_neighbourhoods: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64))
     notes: tuple[str, ...] = field(default=())
+    exact: ExactReport = field(default_factory=lambda: ExactReport(0, 0, 0, 0))
 
 
 def _cycle_geometry(points, cs: CycleSet):
@@ -588,6 +595,20 @@ def _greedy(prob: _Problem, comp, state, rank, conflicts):
             use[int(e)] += 1
 
 
+def _region(prob: _Problem, failed: list[int], lone_edge: np.ndarray, n: int) -> np.ndarray:
+    """The cycles the exact selection re-decides: the failed components, and the
+    cycles fixed next to them (sharing a sample) because one of their edges lies
+    in no other candidate (right on a true boundary, wrong on a closed surface)."""
+    near = np.zeros(n, dtype=bool)
+    for c in failed:
+        near[prob.cycle_vertices[c]] = True
+    lone_cycle = np.zeros(len(prob.cycle_vertices), dtype=bool)
+    lone_cycle[np.unique(prob.inc_cycle[lone_edge[prob.inc_edge]])] = True
+    touch = np.zeros(len(prob.cycle_vertices), dtype=bool)
+    touch[np.unique(prob.corner_owner[near[prob.corner_vertex]])] = True
+    return np.union1d(np.asarray(failed, dtype=np.int64), np.flatnonzero(lone_cycle & touch))
+
+
 def backtracking(
     points,
     edges,
@@ -597,6 +618,7 @@ def backtracking(
     k: int | None = None,
     neighbourhoods: Neighbourhoods | None = None,
     budget: int = 20000,
+    exact_seconds: float = 5.0,
     quiet: bool = True,
 ) -> FaceSelection:
     """Backtracking({}, {◇_i}, k): Algorithm 4, a closed manifold set of face cycles.
@@ -626,6 +648,9 @@ def backtracking(
         :attr:`LocalizedRNG.neighbourhoods`), to avoid recomputing them.
     budget : int
         Maximum assignments of the strict search per component.
+    exact_seconds : float
+        Budget of the exact selection (:mod:`sr33.selection`) per region
+        component where the strict search failed; 0 keeps the greedy answer.
     quiet : bool
         Hide the progress bar.
 
@@ -708,6 +733,7 @@ def backtracking(
     sys.setrecursionlimit(max(old_limit, 20000))
     total = 0
     fallback = 0
+    failed: list[int] = []
     try:
         with bar(len(comps), "backtracking", quiet) as pbar:
             for comp in comps:
@@ -720,11 +746,37 @@ def backtracking(
                 if not ok:
                     state[:] = snapshot
                     fallback += 1
+                    failed.extend(comp)
                     _greedy(prob, comp, state, rank, conflicts)
                 pbar.update(1)
     finally:
         sys.setrecursionlimit(old_limit)
 
+    exact = ExactReport(0, 0, 0, 0)
+    lone_edge = prob.n_cycles_at_edge == 1
+    if failed and exact_seconds > 0:
+        region = _region(prob, failed, lone_edge, n)
+        # the region's fixed cycles were not free: their crossings are new
+        mask = np.zeros(nc, dtype=bool)
+        mask[region] = True
+        exact_conflicts = {c: list(d) for c, d in conflicts.items()}
+        for a, b in _crossing_pairs(pts, cycles, centroid, mask).tolist():
+            exact_conflicts.setdefault(int(a), []).append(int(b))
+            exact_conflicts.setdefault(int(b), []).append(int(a))
+        exact = exact_selection(
+            prob.cycle_edge_ids,
+            prob.cycle_vertices,
+            prob.corner_owner,
+            prob.corner_vertex,
+            prob.corner_prev,
+            prob.corner_next,
+            e,
+            n,
+            state,
+            region,
+            exact_conflicts,
+            seconds=exact_seconds,
+        )
     selected = state == 1
     faces = cycles.subset(selected)
     # final checks: edge use, links, coverage
@@ -740,7 +792,17 @@ def backtracking(
     )
     unresolved = np.flatnonzero(~disk)
     unresolved_arr = unresolved.astype(np.int64)
-    success = over == 0 and unresolved_arr.shape[0] == 0 and fallback == 0
+    # the paper's success condition: no overload, every used sample's link a
+    # disk, open edges only where an edge lies in one candidate (a true
+    # boundary); stray samples are allowed (cones attach them, Section 5)
+    used_sample = np.zeros(n, dtype=bool)
+    used_sample[prob.corner_vertex[sel_corner]] = True
+    success = (
+        len(faces) > 0
+        and over == 0
+        and not np.any(used_sample & ~disk)
+        and not np.any((use == 1) & ~lone_edge)
+    )
     non_disk = np.empty(0, dtype=np.int64)
     if (k is not None or neighbourhoods is not None) and len(faces):
         nb = neighbourhoods or k_neighbourhoods(pts, k, tolerance=tolerance)
@@ -776,4 +838,5 @@ def backtracking(
         assignments=total,
         non_disk_neighbourhoods=non_disk,
         notes=tuple(notes),
+        exact=exact,
     )

@@ -129,27 +129,100 @@ def attach_cones(
         return tri.copy(), strays
     tris = [tuple(t) for t in tri.tolist()]
     alive = [True] * len(tris)
-    for p in strays.tolist():
-        live = [i for i, ok in enumerate(alive) if ok]
-        cen = pts[np.array([tris[i] for i in live])].mean(axis=1)
-        tree = cKDTree(cen)
-        kq = min(candidates, len(live))
-        _, near = tree.query(pts[p], kq)
-        near = np.atleast_1d(near)
-        cand = np.array([live[j] for j in near.tolist()], dtype=np.int64)
-        d2, _ = closest_points_on_triangles(
-            np.repeat(pts[p][None], cand.size, axis=0), pts[np.array([tris[i] for i in cand])]
-        )
-        best = int(cand[np.lexsort((cand, d2))[0]])  # nearest; ties: the earliest triangle
-        a, b, c = tris[best]
-        alive[best] = False
-        for new in ((a, b, p), (b, c, p), (c, a, p)):
-            tris.append(new)
+    origin = list(range(len(tris)))  # every triangle's ancestor in the input
+    family: dict[int, set[int]] = {i: {i} for i in range(len(tris))}
+    owner: dict[tuple[int, int], int] = {}
+    for i, (a, b, c) in enumerate(tris):
+        owner[a, b] = owner[b, c] = owner[c, a] = i
+    tree = cKDTree(pts[tri].mean(axis=1))
+    kq = min(candidates, len(tris))
+
+    def replace(old: list[int], new: list[tuple[int, int, int]], src: list[int]) -> None:
+        for i in old:
+            alive[i] = False
+            family[origin[i]].discard(i)
+            a, b, c = tris[i]
+            for key in ((a, b), (b, c), (c, a)):
+                if owner.get(key) == i:
+                    del owner[key]
+        for t, o in zip(new, src):
+            j = len(tris)
+            tris.append(t)
             alive.append(True)
+            origin.append(o)
+            family[o].add(j)
+            owner[t[0], t[1]] = owner[t[1], t[2]] = owner[t[2], t[0]] = j
+
+    for p in strays.tolist():
+        _, near = tree.query(pts[p], kq)
+        cand = sorted({j for o in np.atleast_1d(near).tolist() for j in family[o]})
+        options = _insertions(pts, p, cand, tris, owner)
+        local = np.array([tris[i] for i in cand], dtype=np.int64)
+        pick = None
+        for _, old, new in options:
+            if _flat(pts, new):
+                continue
+            keep_i = [k for k, i in enumerate(cand) if i not in old]
+            patch = np.vstack([np.array(new, dtype=np.int64), local[keep_i]])
+            m = len(new)
+            hits = self_intersections(pts, patch, keep=lambda a, b, m=m: (a < m) | (b < m))
+            if not hits.shape[0]:
+                pick = (old, new)
+                break
+        if pick is None:  # every insertion crosses something: the nearest one
+            solid = [o for o in options if not _flat(pts, o[2])] or options
+            pick = solid[0][1:]
+        old, new = pick
+        o0, o1 = origin[old[0]], origin[old[-1]]
+        replace(old, new, [o0] * 3 if len(old) == 1 else [o0, o0, o1, o1])
     out = np.array([t for t, ok in zip(tris, alive) if ok], dtype=np.int64)
     if flips:
         out = flip_sharper(pts, out, strays)
     return out, strays
+
+
+def _flat(pts, triangles) -> bool:
+    """Whether a triangle has (numerically) no area: its sample on an edge's line."""
+    t = pts[np.asarray(triangles, dtype=np.int64)]
+    cr = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    longest = max(float(norm(t[:, 1] - t[:, 0]).max()), float(norm(t[:, 2] - t[:, 0]).max()))
+    return bool(np.any(norm(cr) <= 1e-9 * longest * longest))
+
+
+def _insertions(pts, p: int, cand: list[int], tris, owner) -> list:
+    """Ways to insert sample ``p``, nearest first: (distance, removed, added).
+
+    Splitting a triangle (1 → 3) or an edge of two coherently oriented
+    triangles (2 → 4, the way back to a sharp edge a bevel cut off); the
+    new triangles keep the orientation of those they replace.  Ties are
+    broken by kind (triangles first) and triangle index.
+    """
+    q = pts[p]
+    corners = np.array([tris[i] for i in cand], dtype=np.int64)
+    d2, _ = closest_points_on_triangles(np.repeat(q[None], len(cand), axis=0), pts[corners])
+    out = []
+    pairs = []
+    for k, i in enumerate(cand):
+        a, b, c = tris[i]
+        out.append((float(d2[k]), 0, i, [i], [(a, b, p), (b, c, p), (c, a, p)]))
+        for u, v in ((a, b), (b, c), (c, a)):
+            j = owner.get((v, u))
+            if j is None or j < i and j in cand:
+                continue  # a boundary edge, or the pair was seen from j
+            w = next(x for x in tris[j] if x != u and x != v)
+            third = next(x for x in (a, b, c) if x != u and x != v)
+            if w != third:
+                pairs.append((u, v, i, j, third, w))
+    if pairs:
+        uv = np.array([(r[0], r[1]) for r in pairs], dtype=np.int64)
+        seg = pts[uv[:, 1]] - pts[uv[:, 0]]
+        t = np.clip(dot(q - pts[uv[:, 0]], seg) / np.maximum(dot(seg, seg), 1e-300), 0.0, 1.0)
+        off = q - (pts[uv[:, 0]] + t[:, None] * seg)
+        dist2 = dot(off, off)
+        for (u, v, i, j, third, w), dd in zip(pairs, dist2.tolist()):
+            out.append((dd, 1, i, [i, j], [(u, p, third), (p, v, third), (v, p, w), (p, u, w)]))
+    out.sort(key=lambda r: (r[0], r[1], r[2]))
+    return [(r[0], r[3], r[4]) for r in out]
 
 
 def _normal(points, tri) -> np.ndarray:

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
+from scipy.spatial import cKDTree
 
 SQRT3_2 = float(np.sqrt(3.0) / 2.0)  # Condition III-ii: shorter edges below this times the longest
 
@@ -370,46 +371,49 @@ def _segments_cross_triangles(p0, p1, a, b, c, eps):
 
 
 def _candidate_pairs(lo: np.ndarray, hi: np.ndarray, keep=None) -> np.ndarray:
-    """Pairs of boxes sharing a cell of a uniform grid (cell = median box size).
+    """Pairs of boxes that may overlap, found with a k-d tree (memory bounded by
+    the number of pairs found, not by the extent of the boxes).
 
-    Every box is entered in each cell it overlaps; pairs are generated per
-    cell, filtered by ``keep`` (if given) before deduplication, and reported
-    once.  Unlike one search radius for all, a few large triangles do not
-    make every small one a candidate of every other.
+    Box i is a ball of radius ``r_i`` (half its largest side) round its centre
+    in the maximum norm; two boxes can overlap only if their centres are
+    within ``r_i + r_j``.  Boxes up to eight times the median radius are
+    queried through :class:`scipy.spatial.cKDTree` with ``r_i + r_max`` (the
+    largest such radius); the few larger ones (an outlier's long triangles)
+    are compared with every box directly, in chunks.  ``keep`` (if given)
+    filters the pairs before deduplication; each pair is reported once.
     """
-    ext = (hi - lo).max(axis=1)
-    cell = float(np.median(ext)) or float(ext.max()) or 1.0
-    origin = lo.min(axis=0)
-    c0 = np.floor((lo - origin) / cell).astype(np.int64)
-    c1 = np.floor((hi - origin) / cell).astype(np.int64)
-    span = c1 - c0 + 1
-    count = span.prod(axis=1)
-    owner = np.repeat(np.arange(lo.shape[0]), count)
-    start = np.repeat(np.cumsum(count) - count, count)
-    k = np.arange(owner.shape[0]) - start
-    sx, sy = span[owner, 0], span[owner, 1]
-    ix = c0[owner, 0] + k % sx
-    iy = c0[owner, 1] + (k // sx) % sy
-    iz = c0[owner, 2] + k // (sx * sy)
-    dims = c1.max(axis=0) + 1
-    key = (ix * dims[1] + iy) * dims[2] + iz
-    order = np.argsort(key, kind="stable")
-    key, owner = key[order], owner[order]
-    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-    sizes = np.diff(np.r_[starts, key.shape[0]])
-    # every element pairs with the later elements of its cell, vectorized
-    group_end = np.repeat(starts + sizes, sizes)
-    later = group_end - np.arange(key.shape[0]) - 1
-    if later.sum() == 0:
+    n = lo.shape[0]
+    centre = 0.5 * lo + 0.5 * hi  # no overflow at 1e308
+    radius = (0.5 * hi - 0.5 * lo).max(axis=1)
+    typical = float(np.median(radius))
+    big = radius > 8.0 * typical if typical > 0 else np.zeros(n, dtype=bool)
+    small = np.flatnonzero(~big)
+    found_a, found_b = [], []
+    if small.shape[0] > 1:
+        tree = cKDTree(centre[small])
+        reach = radius[small] + float(radius[small].max())
+        hits = tree.query_ball_point(centre[small], reach, p=np.inf)
+        counts = np.fromiter((len(h) for h in hits), dtype=np.int64, count=len(hits))
+        if counts.sum():
+            a = np.repeat(small, counts)
+            b = small[np.concatenate([np.asarray(h, dtype=np.int64) for h in hits])]
+            found_a.append(a)
+            found_b.append(b)
+    for i in np.flatnonzero(big).tolist():
+        for s0 in range(0, n, 65536):
+            j = np.arange(s0, min(n, s0 + 65536))
+            ok = np.all((lo[j] <= hi[i]) & (lo[i] <= hi[j]), axis=1)
+            found_a.append(np.full(int(ok.sum()), i, dtype=np.int64))
+            found_b.append(j[ok])
+    if not found_a:
         return np.empty((0, 2), dtype=np.int64)
-    first = np.repeat(np.arange(key.shape[0]), later)
-    offset = np.arange(first.shape[0]) - np.repeat(np.cumsum(later) - later, later)
-    a, b = owner[first], owner[first + 1 + offset]
+    a, b = np.concatenate(found_a), np.concatenate(found_b)
     ok = a != b
     if keep is not None:
         ok &= keep(a, b)
     a, b = a[ok], b[ok]
-    n = lo.shape[0]
+    if a.shape[0] == 0:
+        return np.empty((0, 2), dtype=np.int64)
     keys = np.unique(edge_keys(a, b, n))
     return np.stack([keys // n, keys % n], axis=1)
 

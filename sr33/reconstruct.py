@@ -16,6 +16,7 @@ from ._validate import as_points, check_k, check_max_cycle_length, check_not_deg
 from .backtracking import backtracking
 from .cones import attach_cones, ring_centres
 from .cycles import CycleSet, trivial_isometric_cycles
+from .mesh import self_intersections
 from .progress import log, timed
 from .rng import localized_rng
 from .selfcheck import check_faces_and_triangles, strict_default
@@ -110,6 +111,7 @@ def reconstruct(
     *,
     max_cycle_length: int = 8,
     budget: int = 20000,
+    exact_seconds: float = 5.0,
     tolerance: Tolerance = DEFAULT,
     quiet: bool = True,
     strict: bool | None = None,
@@ -127,6 +129,9 @@ def reconstruct(
         Longest candidate face cycle (Algorithm 3, see :mod:`sr33.cycles`).
     budget : int
         Search assignments per ambiguous component (see :mod:`sr33.backtracking`).
+    exact_seconds : float
+        Budget of the exact selection per region the search failed on (see
+        :mod:`sr33.selection`); 0 keeps the greedy fallback's answer.
     tolerance : Tolerance
         Tie and fold tolerances (:mod:`sr33.tolerance`).
     quiet : bool
@@ -177,11 +182,21 @@ def reconstruct(
             k=k,
             neighbourhoods=rng.neighbourhoods,
             budget=budget,
+            exact_seconds=exact_seconds,
             quiet=quiet,
         )
     with timed("triangulate", timings):
         centres = ring_centres(pts, sel.faces)
         tr = triangulate(pts, sel.faces, rtol=tolerance.rtol, centres=centres)
+        if centres:
+            # a ring-centre fan that crosses another triangle (a bevelled
+            # acute edge's sample under a quad) gives its sample back to the
+            # cones, which insert it where nothing crosses
+            hits = self_intersections(pts, tr.triangles)
+            bad = set(tr.face_of_triangle[hits.ravel()].tolist()) & set(centres)
+            if bad:
+                centres = {f: c for f, c in centres.items() if f not in bad}
+                tr = triangulate(pts, sel.faces, rtol=tolerance.rtol, centres=centres)
         tri = tr.triangles
     if strict_default() if strict is None else strict:
         with timed("self_checks", timings):

@@ -69,16 +69,17 @@ def _bevelled_roof(angle_deg, n=12, rows=4):
 
 @pytest.mark.parametrize("angle", [20.0, 40.0, 60.0, 90.0])
 def test_cones_on_a_bevel_are_flipped_back_to_the_sharp_edge(angle):
-    """The stray samples of a bevelled sharp edge, coned on and flipped for
-    the least total absolute curvature, lie on one line of edges again, with
-    no two triangles crossing (cones alone: tents that cross)."""
+    """The stray samples of a bevelled sharp edge, inserted where no new
+    triangle crosses another (an edge split or a cone) and flipped for the
+    least total absolute curvature, lie on one line of edges again, with no
+    two triangles crossing, before the flips and after."""
     from sr33.mesh import half_edges, self_intersections, unique_edges
 
     pts, tri, ridge = _bevelled_roof(angle)
     tents, _ = attach_cones(pts, tri, flips=False)
     out, strays = attach_cones(pts, tri)
     assert sorted(strays.tolist()) == ridge
-    assert self_intersections(pts, tents).shape[0] > 0
+    assert self_intersections(pts, tents).shape[0] == 0
     assert self_intersections(pts, out).shape[0] == 0
     edges = {tuple(e) for e in unique_edges(half_edges(out)[0]).tolist()}
     assert all((a, b) in edges for a, b in zip(ridge[:-1], ridge[1:]))

@@ -1,0 +1,592 @@
+"""Exact selection of face cycles where the backtracking search fails (Section 4).
+
+Algorithm 4 asks for a maximal set of face cycles in which every edge is
+used at most twice and every sample's neighbourhood is a disk.  The
+propagation search of :mod:`sr33.backtracking` decides almost every
+component at once; where it proves a component infeasible or runs out of
+budget (acute sharp edges, where the Euclidean RNG loses within-face edges
+and the strict rules leave no closed choice), this module solves the same
+selection exactly, as a constraint program (OR-Tools CP-SAT, one worker,
+fixed seed, a deterministic-time budget: the same model always gives the
+same answer).
+
+The model, over the cycles of one *region* (the failed components and the
+cycles fixed next to them), with the rest of the selection held fixed:
+
+* ``x_c`` — cycle ``c`` is a face;
+* every edge is used ``2 y_e + o_e`` times (``o_e`` = open); the first
+  round allows no open edge at all (a closed surface, Section 4's aim), the
+  second allows open edges and minimises them;
+* folding or crossing cycles are never both faces (the conflicts of
+  :mod:`sr33.backtracking`);
+* a sample is *stray* when no face uses it: the paper's success condition
+  allows that and attaches it later with cones (end of Section 5);
+* the link of every sample is one cycle or one path (the vertex form of
+  "Conv(N(u; k)) ∩ P' is a disk"): a circuit constraint per sample, added
+  lazily at the samples where a solution was pinched;
+* no detached closed bubble: every face reaches a face outside the region
+  through faces (rooted connectivity by levels, up front; a connectivity
+  cut per bubble found, lazily, where the component touches no outside
+  face and its largest piece is kept).
+
+The objective is lexicographic: open edges, then the negative Euler
+characteristic of the region (each handle costs 2; V counts used samples,
+so covering a sample with the same topology changes nothing), then stray
+samples, then the sides beyond three (smaller faces first, as the search's
+rank).  Maximising the Euler characteristic keeps the solver from buying
+coverage with handles.  It is solved in two phases from the same model:
+stray samples first without the Euler term (fast, and proven optimal on
+the library shapes), then with it, warm-started from the first answer.
+An answer is taken only when it is valid (edge use at most two, links
+disks) and strictly better than the selection it replaces, so the result
+is never worse than the greedy fallback.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse import csgraph
+
+from .progress import log
+
+#: deterministic-time units per second of budget (CP-SAT's deterministic
+#: time is close to seconds of one core on this kind of model)
+_DET_PER_SECOND = 0.25
+
+
+@dataclass(frozen=True)
+class ExactReport:
+    """What :func:`exact_selection` did.
+
+    Attributes
+    ----------
+    components : int
+        Region components solved (connected through shared samples).
+    improved : int
+        Components whose answer replaced the selection given.
+    proven : int
+        Components whose answer is proven optimal for the model.
+    cuts : int
+        Lazy constraints added (vertex links and bubbles).
+    """
+
+    components: int
+    improved: int
+    proven: int
+    cuts: int
+
+
+@dataclass
+class _Tables:
+    """Incidence of the cycles, edges and corners (all cycles, not one region)."""
+
+    cycle_edges: list  # per cycle: its edge ids
+    cycle_vertices: list  # per cycle: its vertices
+    edge_cycles: sparse.csr_matrix  # edge -> cycles
+    vertex_corners: sparse.csr_matrix  # vertex -> corner index + 1
+    corner_owner: np.ndarray
+    corner_prev: np.ndarray
+    corner_next: np.ndarray
+    edge_of: dict  # (a, b) sorted -> edge id
+    n_points: int
+
+    def cycles_at_edge(self, e: int) -> np.ndarray:
+        ec = self.edge_cycles
+        return ec.indices[ec.indptr[e] : ec.indptr[e + 1]]
+
+    def corners_at(self, v: int) -> np.ndarray:
+        vc = self.vertex_corners
+        return vc.data[vc.indptr[v] : vc.indptr[v + 1]] - 1
+
+
+def _tables(
+    cycle_edge_ids,
+    cycle_vertices,
+    corner_owner,
+    corner_vertex,
+    corner_prev,
+    corner_next,
+    n_edges,
+    n_points,
+    edges,
+) -> _Tables:
+    owner = np.repeat(np.arange(len(cycle_edge_ids)), [len(c) for c in cycle_edge_ids])
+    flat = np.concatenate(cycle_edge_ids) if len(cycle_edge_ids) else np.empty(0, np.int64)
+    ec = sparse.csr_matrix(
+        (np.ones(flat.shape[0], dtype=np.int8), (flat, owner)),
+        shape=(n_edges, len(cycle_edge_ids)),
+    )
+    ec.sort_indices()
+    s = corner_vertex.shape[0]
+    vc = sparse.csr_matrix(
+        (np.arange(1, s + 1), (corner_vertex, np.arange(s))), shape=(n_points, s)
+    )
+    vc.sort_indices()
+    edge_of = {(int(a), int(b)): i for i, (a, b) in enumerate(np.asarray(edges).tolist())}
+    return _Tables(
+        list(cycle_edge_ids),
+        list(cycle_vertices),
+        ec,
+        vc,
+        corner_owner,
+        corner_prev,
+        corner_next,
+        edge_of,
+        n_points,
+    )
+
+
+@dataclass(frozen=True)
+class _Score:
+    over: int
+    open: int
+    open_lone: int
+    minus_chi: int
+    strays: int
+    sides: int
+
+    def better_than(self, old: _Score, closed: bool) -> bool:
+        """The order of the model's objective (closed or open)."""
+        if self.over:
+            return False
+        if old.over or (closed and old.open):
+            return True
+        if closed:
+            return (self.minus_chi, self.strays, self.sides) < (
+                old.minus_chi,
+                old.strays,
+                old.sides,
+            )
+        key = (self.open + self.strays, self.open_lone, self.sides)
+        return key < (old.open + old.strays, old.open_lone, old.sides)
+
+
+def _score(tab: _Tables, state: np.ndarray, cycles, edges_, verts, lone) -> _Score:
+    """(overloaded, open, open true-boundary edges, -Euler characteristic,
+    strays, sides beyond three) of ``state`` over a region: the model's
+    objective, lexicographic."""
+    use = {}
+    for e in edges_:
+        use[e] = int(sum(1 for c in tab.cycles_at_edge(e) if state[c] == 1))
+    over = sum(1 for u in use.values() if u > 2)
+    open_ = sum(1 for e, u in use.items() if u == 1 and e not in lone)
+    open_lone = sum(1 for e, u in use.items() if u == 1 and e in lone)
+    used_e = sum(1 for u in use.values() if u > 0)
+    cov = 0
+    for v in verts:
+        if any(state[tab.corner_owner[k]] == 1 for k in tab.corners_at(v)):
+            cov += 1
+    faces = sum(1 for c in cycles if state[c] == 1)
+    chi = cov - used_e + faces
+    sides = sum(len(tab.cycle_edges[c]) - 3 for c in cycles if state[c] == 1)
+    return _Score(over, open_, open_lone, -chi, len(verts) - cov, sides)
+
+
+def _link_ok(tab: _Tables, state: np.ndarray, v: int) -> bool:
+    """Whether the selected corners at ``v`` form one path or one cycle (or none)."""
+    pairs = [
+        (int(tab.corner_prev[k]), int(tab.corner_next[k]))
+        for k in tab.corners_at(v)
+        if state[tab.corner_owner[k]] == 1
+    ]
+    if not pairs:
+        return True
+    deg: dict[int, int] = {}
+    adj: dict[int, list[int]] = {}
+    for p, q in pairs:
+        if p == q:
+            return False
+        for a, b in ((p, q), (q, p)):
+            deg[a] = deg.get(a, 0) + 1
+            adj.setdefault(a, []).append(b)
+    if max(deg.values()) > 2:
+        return False
+    start = next(iter(adj))
+    seen = {start}
+    stack = [start]
+    while stack:
+        for y in adj[stack.pop()]:
+            if y not in seen:
+                seen.add(y)
+                stack.append(y)
+    return len(seen) == len(adj)
+
+
+def _bubbles(tab: _Tables, state: np.ndarray, cycles, outside_faces: bool) -> list[list[int]]:
+    """Connected sets of selected region cycles that touch no selected cycle outside.
+
+    When nothing outside the region is selected, the largest set (then the
+    one with the smallest cycle index) is kept and the others are bubbles.
+    """
+    region = [c for c in cycles if state[c] == 1]
+    if not region:
+        return []
+    index = {c: i for i, c in enumerate(region)}
+    rows, cols = [], []
+    anchored = np.zeros(len(region), dtype=bool)
+    for c in region:
+        for e in tab.cycle_edges[c]:
+            for d in tab.cycles_at_edge(int(e)):
+                d = int(d)
+                if d == c or state[d] != 1:
+                    continue
+                if d in index:
+                    rows.append(index[c])
+                    cols.append(index[d])
+                else:
+                    anchored[index[c]] = True
+    g = sparse.csr_matrix(
+        (np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(len(region), len(region))
+    )
+    ncomp, labels = csgraph.connected_components(g, directed=False)
+    groups = [[region[i] for i in np.flatnonzero(labels == j)] for j in range(ncomp)]
+    if outside_faces:
+        return [grp for j, grp in enumerate(groups) if not anchored[labels == j].any()]
+    keep = max(range(ncomp), key=lambda j: (len(groups[j]), -min(groups[j])))
+    return [grp for j, grp in enumerate(groups) if j != keep]
+
+
+def _connect(m, tab, state, cycles, cyc_set, x) -> None:
+    """Every face of the region reaches a face outside it through faces.
+
+    Rooted connectivity by levels: a face next to a fixed face outside may
+    take level 0; any other face needs a neighbouring face (sharing an edge)
+    of a lower level.  This forbids detached bubbles up front.
+    """
+    depth = len(cycles)
+    level = {c: m.NewIntVar(0, depth, f"l{c}") for c in cycles}
+    for c in cycles:
+        anchored = False
+        preds = []
+        for e in tab.cycle_edges[c]:
+            for d in tab.cycles_at_edge(int(e)):
+                d = int(d)
+                if d == c:
+                    continue
+                if d not in cyc_set:
+                    anchored = anchored or state[d] == 1
+                    continue
+                preds.append(d)
+        if anchored:
+            continue
+        lits = []
+        for d in sorted(set(preds)):
+            a = m.NewBoolVar("")
+            m.AddImplication(a, x[d])
+            m.Add(level[d] < level[c]).OnlyEnforceIf(a)
+            lits.append(a)
+        m.AddBoolOr(lits + [x[c].Not()])
+
+
+def _solve_component(
+    tab, state, cycles, conflicts, lone, seconds, max_rounds, links, allow_open, chi
+):
+    """One CP-SAT model over ``cycles``, lazy rounds until valid.
+
+    ``links`` are the samples whose link circuit is added up front; it is
+    extended with the samples cut lazily.  Returns (new state or None,
+    proven, cuts).
+    """
+    from ortools.sat.python import cp_model
+
+    cyc_set = set(cycles)
+    edges_ = sorted({int(e) for c in cycles for e in tab.cycle_edges[c]})
+    verts = sorted({int(v) for c in cycles for v in tab.cycle_vertices[c]})
+    m = cp_model.CpModel()
+    x = {c: m.NewBoolVar(f"x{c}") for c in cycles}
+    hint = {c: int(state[c] == 1) for c in cycles}
+    for c, val in hint.items():
+        m.AddHint(x[c], val)
+    y, o = {}, {}
+    for e in edges_:
+        at = [int(c) for c in tab.cycles_at_edge(e)]
+        fixed = sum(1 for c in at if c not in cyc_set and state[c] == 1)
+        terms = [x[c] for c in at if c in cyc_set]
+        y[e] = m.NewBoolVar(f"y{e}")
+        if allow_open:
+            o[e] = m.NewBoolVar(f"o{e}")
+            m.Add(sum(terms) + fixed == 2 * y[e] + o[e])
+        else:
+            m.Add(sum(terms) + fixed == 2 * y[e])
+    for c in cycles:
+        for d in conflicts.get(c, ()):
+            if d in cyc_set and d > c:
+                m.AddBoolOr([x[c].Not(), x[d].Not()])
+            elif d not in cyc_set and state[d] == 1:
+                m.Add(x[c] == 0)
+    cov = {}
+    for v in verts:
+        ks = tab.corners_at(v)
+        owners = sorted({int(tab.corner_owner[k]) for k in ks})
+        if any(c not in cyc_set and state[c] == 1 for c in owners):
+            cov[v] = 1
+            continue
+        cv = m.NewBoolVar(f"v{v}")
+        mine = [x[c] for c in owners if c in cyc_set]
+        for lit in mine:
+            m.AddImplication(lit, cv)
+        m.AddBoolOr(mine + [cv.Not()])
+        cov[v] = cv
+    # objective, lexicographic by weights.  Closed model: -chi (when asked),
+    # then strays, then sides beyond three.  Open model (no closed answer):
+    # open edges and strays together (a hole and a lost sample weigh the
+    # same; removing faces to avoid an open edge loses their samples), then
+    # open true-boundary edges, then sides.
+    nv, ne = len(verts), len(edges_)
+    extra = {c: len(tab.cycle_edges[c]) - 3 for c in cycles}  # sides beyond three
+    strays = [1 - cov[v] if isinstance(cov[v], int) else cov[v].Not() for v in verts]
+    sides = sum(extra[c] * x[c] for c in cycles)
+    w_stray = 1 + sum(extra.values())
+    if allow_open:
+        open_bad = [o[e] for e in edges_ if e in o and e not in lone]
+        open_lone = [o[e] for e in edges_ if e in o and e in lone]
+        w_main = w_stray * (ne + 1)
+        obj = w_main * (sum(open_bad) + sum(strays)) + w_stray * sum(open_lone) + sides
+    else:
+        w_chi = w_stray * (nv + 1) if chi else 0
+        chi_terms = [cov[v] for v in verts]
+        used = [y[e] for e in edges_]
+        obj = (
+            -w_chi * (sum(chi_terms) - sum(used) + sum(x.values())) + w_stray * sum(strays) + sides
+        )
+    m.Minimize(obj)
+
+    linked: set[int] = set()
+
+    def add_link(v: int) -> None:
+        linked.add(v)
+        links.add(v)
+        ks = tab.corners_at(v)
+        node: dict[int, int] = {}
+        for k in ks:
+            for w in (int(tab.corner_prev[k]), int(tab.corner_next[k])):
+                node.setdefault(w, len(node))
+        arcs = []
+        for k in ks:
+            c = int(tab.corner_owner[k])
+            p, q = node[int(tab.corner_prev[k])], node[int(tab.corner_next[k])]
+            if c in cyc_set:
+                a, b = m.NewBoolVar(""), m.NewBoolVar("")
+                m.Add(a + b == x[c])
+            elif state[c] == 1:
+                a, b = m.NewBoolVar(""), m.NewBoolVar("")
+                m.Add(a + b == 1)
+            else:
+                continue
+            arcs += [(p, q, a), (q, p, b)]
+        dummy = len(node)
+        any_open = []
+        for w, i in node.items():
+            e = tab.edge_of[(min(v, w), max(v, w))]
+            if e in y:
+                used_lit = y[e]
+                if e in o:
+                    u = m.NewBoolVar("")
+                    m.AddBoolOr([y[e], o[e], u.Not()])
+                    m.AddImplication(y[e], u)
+                    m.AddImplication(o[e], u)
+                    used_lit = u
+                arcs.append((i, i, used_lit.Not()))
+                if e in o:
+                    d1, d2 = m.NewBoolVar(""), m.NewBoolVar("")
+                    m.Add(d1 + d2 == o[e])
+                    arcs += [(dummy, i, d1), (i, dummy, d2)]
+                    any_open.append(o[e])
+            else:
+                at = [int(c) for c in tab.cycles_at_edge(e)]
+                fixed = sum(1 for c in at if state[c] == 1)
+                if fixed == 0:
+                    arcs.append((i, i, m.NewConstant(1)))
+                elif fixed == 1:
+                    d1, d2 = m.NewBoolVar(""), m.NewBoolVar("")
+                    m.Add(d1 + d2 == 1)
+                    arcs += [(dummy, i, d1), (i, dummy, d2)]
+                    any_open.append(m.NewConstant(1))
+        skip = m.NewBoolVar("")
+        for lit in any_open:
+            m.AddImplication(lit, skip.Not())
+        arcs.append((dummy, dummy, skip))
+        m.AddCircuit(arcs)
+
+    for v in sorted(links & set(verts)):
+        add_link(v)
+    # a component next to faces outside it must reach them; one that touches
+    # none (a separate object) keeps its largest piece
+    outside = any(
+        int(d) not in cyc_set and state[d] == 1
+        for c in cycles
+        for e in tab.cycle_edges[c]
+        for d in tab.cycles_at_edge(int(e))
+    )
+    if outside:
+        _connect(m, tab, state, cycles, cyc_set, x)
+    elif not allow_open:
+        m.Add(sum(x.values()) >= 1)  # closing a lone component by deleting it
+    solver = cp_model.CpSolver()
+    solver.parameters.num_workers = 1
+    solver.parameters.random_seed = 0
+    solver.parameters.randomize_search = False
+    budget = seconds * _DET_PER_SECOND
+    cuts = 0
+    best = None
+    proven = False
+    for _ in range(max_rounds):
+        if budget <= 0:
+            break
+        solver.parameters.max_deterministic_time = budget
+        status = solver.Solve(m)
+        budget -= solver.deterministic_time
+        if status not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
+            break
+        trial = state.copy()
+        for c in cycles:
+            trial[c] = int(solver.Value(x[c]))
+        bad = [v for v in verts if v not in linked and not _link_ok(tab, trial, v)]
+        bubbles = _bubbles(tab, trial, cycles, outside)
+        for v in bad:
+            add_link(v)
+        for grp in bubbles:
+            # connectivity cut: a face of the bubble needs a face next to it
+            # outside the bubble (every path to the rest leaves through one)
+            inside = set(grp)
+            ring = sorted(
+                {
+                    int(d)
+                    for c in grp
+                    for e in tab.cycle_edges[c]
+                    for d in tab.cycles_at_edge(int(e))
+                    if int(d) in cyc_set and int(d) not in inside
+                }
+            )
+            for c in grp:
+                m.AddBoolOr([x[d] for d in ring] + [x[c].Not()])
+        cuts += len(bad) + len(bubbles)
+        log.debug(
+            "exact selection: %d cycles, open %s, chi %s, status %s, objective %d, "
+            "%d pinched samples, %d bubbles, %.2f deterministic s",
+            len(cycles),
+            allow_open,
+            chi,
+            solver.StatusName(status),
+            solver.ObjectiveValue(),
+            len(bad),
+            len(bubbles),
+            solver.deterministic_time,
+        )
+        if not bad and not bubbles:
+            best = trial
+            proven = status == cp_model.OPTIMAL
+            break
+        # keep the solution as a hint for the next round
+        m.ClearHints()
+        for c in cycles:
+            m.AddHint(x[c], int(trial[c]))
+    return best, proven, cuts
+
+
+def exact_selection(
+    cycle_edge_ids,
+    cycle_vertices,
+    corner_owner,
+    corner_vertex,
+    corner_prev,
+    corner_next,
+    edges,
+    n_points: int,
+    state: np.ndarray,
+    region: np.ndarray,
+    conflicts: dict[int, list[int]],
+    *,
+    seconds: float = 5.0,
+    max_rounds: int = 40,
+    all_links: bool = False,
+) -> ExactReport:
+    """Select the faces of ``region`` exactly; updates ``state`` in place.
+
+    Parameters
+    ----------
+    cycle_edge_ids, cycle_vertices : list of (L,) int64 arrays
+        Every candidate cycle's edge ids and vertices.
+    corner_owner, corner_vertex, corner_prev, corner_next : (s,) int64
+        Every corner (cycle, vertex, previous and next vertex on the cycle).
+    edges : (m, 2) int64
+        The graph's edges (sorted rows), indexed by the edge ids.
+    n_points : int
+        Number of samples.
+    state : (c,) int64
+        1 for a selected cycle, 0 otherwise; cycles of ``region`` are
+        re-decided, the others are held fixed.
+    region : (r,) int64
+        The cycles to decide (failed components and the fixed cycles next
+        to them).
+    conflicts : dict
+        Cycle -> cycles it may not be selected with (folds and crossings).
+    seconds : float
+        Budget per component (CP-SAT deterministic time, shared by the
+        lazy rounds).
+    max_rounds : int
+        Lazy rounds per component.
+    all_links : bool
+        Add every sample's link constraint up front instead of lazily.
+
+    Returns
+    -------
+    ExactReport
+    """
+    edges = np.asarray(edges, dtype=np.int64)
+    tab = _tables(
+        cycle_edge_ids,
+        cycle_vertices,
+        corner_owner,
+        corner_vertex,
+        corner_prev,
+        corner_next,
+        edges.shape[0],
+        n_points,
+        edges,
+    )
+    region = np.unique(np.asarray(region, dtype=np.int64))
+    if region.shape[0] == 0:
+        return ExactReport(0, 0, 0, 0)
+    n_at_edge = np.diff(tab.edge_cycles.indptr)
+    lone = set(np.flatnonzero(n_at_edge == 1).tolist())
+    # components of the region through shared samples
+    owner = np.repeat(np.arange(region.shape[0]), [len(tab.cycle_vertices[c]) for c in region])
+    verts = np.concatenate([tab.cycle_vertices[c] for c in region])
+    g = sparse.csr_matrix(
+        (np.ones(owner.shape[0], dtype=np.int8), (owner, verts + region.shape[0])),
+        shape=(region.shape[0] + n_points,) * 2,
+    )
+    _, labels = csgraph.connected_components(g, directed=False)
+    lab = labels[: region.shape[0]]
+    comps = [region[lab == j].tolist() for j in np.unique(lab)]
+    improved = proven = cuts = 0
+    for comp in comps:
+        edges_ = sorted({int(e) for c in comp for e in tab.cycle_edges[c]})
+        verts_ = sorted({int(v) for c in comp for v in tab.cycle_vertices[c]})
+        links = set(verts_) if all_links else set()
+        before = _score(tab, state, comp, edges_, verts_, lone)
+        for allow_open in (False, True):
+            # coverage first (fast, proven on the library shapes), then the
+            # Euler characteristic from that answer: no handle bought with
+            # coverage (each phase has the budget)
+            best, prov = None, False
+            hint = state
+            for chi in (False, True) if not allow_open else (False,):
+                new, p, cut = _solve_component(
+                    tab, hint, comp, conflicts, lone, seconds, max_rounds, links, allow_open, chi
+                )
+                cuts += cut
+                if new is not None:
+                    best, prov, hint = new, p, new
+            if best is None:
+                continue
+            if _score(tab, best, comp, edges_, verts_, lone).better_than(before, not allow_open):
+                state[:] = best
+                improved += 1
+                proven += int(prov)
+            break
+    return ExactReport(len(comps), improved, proven, cuts)

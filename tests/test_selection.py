@@ -1,0 +1,69 @@
+"""The exact selection (sr33.selection): the paper's success condition where the
+strict search fails, stray samples allowed, no detached bubble, never worse."""
+
+import numpy as np
+
+from sr33 import attach_cones, backtracking, trivial_isometric_cycles
+from sr33.mesh import half_edges, self_intersections, unique_edges, unique_rows
+
+OCTAHEDRON = np.array(
+    [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=float
+)
+OCT_EDGES = [(a, b) for a in range(6) for b in range(a + 1, 6) if a // 2 != b // 2]
+
+
+def _edges(pairs):
+    return unique_rows(np.sort(np.array(pairs, dtype=np.int64), axis=1))
+
+
+def _closed(tri):
+    _, counts = unique_rows(np.sort(half_edges(tri)[0], axis=1), return_counts=True)
+    return bool(np.all(counts == 2))
+
+
+def test_a_closed_selection_leaving_a_sample_stray_is_found():
+    """A sample q joined to two octahedron vertices only: its one candidate
+    (the tent q a b) has two edges in no other candidate, so covering q
+    opens the surface.  The strict search insists on covering every sample
+    and fails; the paper's success condition leaves q stray, closes the
+    octahedron, and the cones attach q."""
+    q = np.array([[0.6, 0.6, 0.1]])  # above the edge (0, 2), outside
+    pts = np.vstack([OCTAHEDRON, q])
+    e = _edges(OCT_EDGES + [(6, 0), (6, 2)])
+    cyc = trivial_isometric_cycles(e, len(pts))
+    assert len(cyc) == 12  # 8 triangles, 3 equatorial squares, the tent
+    strict = backtracking(pts, e, cyc, exact_seconds=0)
+    assert strict.fallback_components == 1 and not strict.success
+    sel = backtracking(pts, e, cyc)
+    assert sel.success and sel.exact.improved == 1 and sel.exact.proven == 1
+    assert sel.open_edges.shape == (0, 2)
+    assert len(sel.faces) == 8 and 6 not in sel.faces.vertices
+    tri = np.array([sel.faces.cycle(i) for i in range(len(sel.faces))])
+    out, strays = attach_cones(pts, tri)
+    assert strays.tolist() == [6]
+    assert _closed(out) and 6 in out
+    assert self_intersections(pts, out).shape[0] == 0
+
+
+def test_a_separate_closed_object_is_kept_a_detached_bubble_is_not():
+    """Two octahedra: the second, standing alone, is a surface of its own
+    and is selected; the same candidates cannot make a bubble next to a
+    surface they do not join (connectivity)."""
+    far = OCTAHEDRON + [10.0, 0, 0]
+    pts = np.vstack([OCTAHEDRON, far])
+    e = _edges(OCT_EDGES + [(a + 6, b + 6) for a, b in OCT_EDGES])
+    cyc = trivial_isometric_cycles(e, len(pts))
+    assert len(cyc) == 22
+    sel = backtracking(pts, e, cyc)
+    assert sel.success and len(sel.faces) == 16
+
+
+def test_the_exact_selection_is_deterministic():
+    q = np.array([[0.6, 0.6, 0.1]])
+    pts = np.vstack([OCTAHEDRON, q])
+    e = _edges(OCT_EDGES + [(6, 0), (6, 2)])
+    cyc = trivial_isometric_cycles(e, len(pts))
+    runs = {backtracking(pts, e, cyc).selected.tobytes() for _ in range(3)}
+    assert len(runs) == 1
+    edges = unique_edges(half_edges(np.array([[0, 2, 4]]))[0])
+    assert edges.shape == (3, 2)
