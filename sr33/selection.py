@@ -317,6 +317,22 @@ def _solve_component(
                 m.AddBoolOr([x[c].Not(), x[d].Not()])
             elif d not in cyc_set and state[d] == 1:
                 m.Add(x[c] == 0)
+    # two faces with the same corner (prev, v, next) fold onto each other at v
+    # (v would have degree two): at most one of them
+    for v in verts:
+        groups: dict[tuple[int, int], list[int]] = {}
+        for k in tab.corners_at(v):
+            a, b = int(tab.corner_prev[k]), int(tab.corner_next[k])
+            groups.setdefault((min(a, b), max(a, b)), []).append(int(tab.corner_owner[k]))
+        for owners in groups.values():
+            if len(owners) < 2:
+                continue
+            mine = [x[c] for c in owners if c in cyc_set]
+            if any(c not in cyc_set and state[c] == 1 for c in owners):
+                for lit in mine:
+                    m.Add(lit == 0)
+            elif len(mine) > 1:
+                m.AddAtMostOne(mine)
     cov = {}
     for v in verts:
         ks = tab.corners_at(v)
