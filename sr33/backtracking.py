@@ -39,11 +39,17 @@ This module searches the same space, made tractable by four observations:
    solution found is the one Algorithm 4 would return with candidates tried
    in that order.
 4. **A budget bounds the search.**  Each component gets ``budget``
-   assignments.  When the strict search fails or exhausts the budget (the
-   sample conditions do not hold there), the component falls back to a
-   greedy pass in rank order that keeps the invariant (no edge above two
-   uses, no vertex link that is not a disk), and the result reports the
-   edges and samples that could not be closed.
+   assignments.  When the strict search fails or exhausts the budget (acute
+   sharp edges, where the RNG cuts across the edge and covering every
+   sample is impossible, or input that does not meet the sample
+   conditions), the component falls back to a greedy pass in rank order
+   that keeps the invariant (no edge above two uses, no vertex link that is
+   not a disk), and then to the exact selection of :mod:`sr33.selection`
+   over the failed components and the cycles fixed next to them because of
+   an edge in no other candidate; it allows stray samples, as the paper's
+   success condition does, and its answer replaces the greedy one only
+   when strictly better.  The result reports the edges and samples that
+   could not be closed.
 """
 
 from __future__ import annotations
@@ -674,6 +680,10 @@ def backtracking(
     e = unique_edges(e) if e.shape[0] else e
     if not isinstance(budget, (int, np.integer)) or budget < 1:
         raise InputError(f"budget must be a positive integer, got {budget!r}")
+    if not isinstance(exact_seconds, (int, float, np.integer, np.floating)) or not (
+        0 <= float(exact_seconds) < float("inf")
+    ):
+        raise InputError(f"exact_seconds must be a finite number >= 0, got {exact_seconds!r}")
     nc = len(cycles)
     if nc == 0:
         return FaceSelection(

@@ -46,6 +46,7 @@ def _cmd_reconstruct(args) -> int:
         args.k,
         max_cycle_length=args.max_cycle_length,
         budget=args.budget,
+        exact_seconds=args.exact_seconds,
         quiet=args.quiet,
     )
     write_mesh(out, r.vertices, r.triangles)
@@ -345,6 +346,14 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--output", required=True, help="output mesh .ply .obj .off .stl .vtp")
     r.add_argument("--max-cycle-length", type=int, default=8, help="longest face cycle")
     r.add_argument("--budget", type=int, default=20000, help="search budget per component")
+    r.add_argument(
+        "--exact-seconds",
+        type=float,
+        default=5.0,
+        help="exact selection budget per failed component and phase, in CP-SAT "
+        "deterministic time (about seconds of one core; the same on every machine; "
+        "default 5; 0 keeps the greedy answer)",
+    )
     r.add_argument("--json", help="also write the summary as JSON here")
     r.add_argument("--save", help="also save the whole reconstruction (.npz) for sr33 view")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bars")

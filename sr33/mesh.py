@@ -376,10 +376,10 @@ def _candidate_pairs(lo: np.ndarray, hi: np.ndarray, keep=None) -> np.ndarray:
 
     Box i is a ball of radius ``r_i`` (half its largest side) round its centre
     in the maximum norm; two boxes can overlap only if their centres are
-    within ``r_i + r_j``.  Boxes up to eight times the median radius are
-    queried through :class:`scipy.spatial.cKDTree` with ``r_i + r_max`` (the
-    largest such radius); the few larger ones (an outlier's long triangles)
-    are compared with every box directly, in chunks.  ``keep`` (if given)
+    within ``r_i + r_j <= 2 max(r_i, r_j)``, so each pair is found by a
+    :class:`scipy.spatial.cKDTree` query of radius ``2 r_i`` from its larger
+    box.  Boxes over eight times the median radius (an outlier's long
+    triangles) are compared with every box directly, in chunks.  ``keep`` (if given)
     filters the pairs before deduplication; each pair is reported once.
     """
     n = lo.shape[0]
@@ -390,15 +390,17 @@ def _candidate_pairs(lo: np.ndarray, hi: np.ndarray, keep=None) -> np.ndarray:
     small = np.flatnonzero(~big)
     found_a, found_b = [], []
     if small.shape[0] > 1:
+        # overlapping boxes have centres within r_i + r_j <= 2 max(r_i, r_j):
+        # every pair is found from its larger box, querying 2 r_i
         tree = cKDTree(centre[small])
-        reach = radius[small] + float(radius[small].max())
-        hits = tree.query_ball_point(centre[small], reach, p=np.inf)
+        hits = tree.query_ball_point(centre[small], 2.0 * radius[small], p=np.inf)
         counts = np.fromiter((len(h) for h in hits), dtype=np.int64, count=len(hits))
         if counts.sum():
             a = np.repeat(small, counts)
             b = small[np.concatenate([np.asarray(h, dtype=np.int64) for h in hits])]
-            found_a.append(a)
-            found_b.append(b)
+            larger = radius[a] >= radius[b]
+            found_a.append(a[larger])
+            found_b.append(b[larger])
     for i in np.flatnonzero(big).tolist():
         for s0 in range(0, n, 65536):
             j = np.arange(s0, min(n, s0 + 65536))

@@ -45,8 +45,9 @@ class Reconstruction:
     face_cycles : CycleSet
         The selected 2-basis (Algorithm 4) before triangulation.
     success : bool
-        Whether the backtracking met its success condition everywhere (no
-        edge used more than twice, every sample's link a disk, no fallback)
+        Whether the backtracking met the paper's success condition (no edge
+        used more than twice, every used sample's link a disk, open edges
+        only on true boundaries; stray samples are attached by the cones)
         and the output is orientable.
     orientable : bool
         Whether the face cycles could be oriented coherently (a closed
@@ -61,8 +62,9 @@ class Reconstruction:
     coned_samples : (s,) int64
         Samples attached by cones at the end (Section 5).
     fallback_components : int
-        Ambiguous components where the strict search failed and the greedy
-        fallback was used (0 when ``success``).
+        Ambiguous components where the strict search failed; the greedy
+        fallback and then the exact selection (:mod:`sr33.selection`)
+        decided them.
     timings : dict[str, float]
         Seconds per step.
     k : int
@@ -186,21 +188,25 @@ def reconstruct(
             quiet=quiet,
         )
     with timed("triangulate", timings):
-        centres = ring_centres(pts, sel.faces)
-        tr = triangulate(pts, sel.faces, rtol=tolerance.rtol, centres=centres)
-        if centres:
+        faces = sel.faces
+        centres = ring_centres(pts, faces)
+        tr = triangulate(pts, faces, rtol=tolerance.rtol, centres=centres)
+        for _ in range(3):
+            if not centres:
+                break
             # a ring-centre fan that crosses another triangle (a bevelled
             # acute edge's sample under a quad) gives its sample back to the
             # cones, which insert it where nothing crosses
             hits = self_intersections(pts, tr.triangles)
             bad = set(tr.face_of_triangle[hits.ravel()].tolist()) & set(centres)
-            if bad:
-                centres = {f: c for f, c in centres.items() if f not in bad}
-                tr = triangulate(pts, sel.faces, rtol=tolerance.rtol, centres=centres)
+            if not bad:
+                break
+            centres = {f: c for f, c in centres.items() if f not in bad}
+            tr = triangulate(pts, faces, rtol=tolerance.rtol, centres=centres)
         tri = tr.triangles
     if strict_default() if strict is None else strict:
         with timed("self_checks", timings):
-            check_faces_and_triangles(sel.faces, tri, tr.face_of_triangle, centres)
+            check_faces_and_triangles(faces, tri, tr.face_of_triangle, centres)
     with timed("cones", timings):
         if tri.shape[0]:
             tri, coned = attach_cones(pts, tri)
@@ -213,7 +219,7 @@ def reconstruct(
     rng_edges = np.sort(relabel[rng.edges], axis=1)
     rng_edges = rng_edges[np.lexsort((rng_edges[:, 1], rng_edges[:, 0]))]
     open_edges = np.sort(relabel[sel.open_edges], axis=1) if sel.open_edges.size else sel.open_edges
-    faces = CycleSet(offsets=sel.faces.offsets, vertices=relabel[sel.faces.vertices])
+    faces = CycleSet(offsets=faces.offsets, vertices=relabel[faces.vertices])
     return Reconstruction(
         vertices=pts[out_order],
         triangles=relabel[tri],

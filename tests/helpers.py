@@ -51,3 +51,26 @@ def grid_edges(nx: int, ny: int) -> set[tuple[int, int]]:
             if j + 1 < ny:
                 out.add((v, v + 1))
     return out
+
+
+def check_homeomorphism(shape, points: np.ndarray, spacing: float, rec) -> None:
+    """The homeomorphism guarantee: same signature as the shape, no open or
+    overloaded edges beyond the shape's boundary, disjoint interiors, every
+    sample used, Hausdorff distance to the truth at most h."""
+    from sr33.validators import mesh_stats
+    from sr33.validators.fidelity import hausdorff
+    from sr33.validators.intersections import self_intersections
+    from sr33.validators.signature import homeomorphic, signature
+
+    sig = signature(rec.triangles, rec.vertices.shape[0], points=rec.vertices)
+    truth = signature(shape.truth_triangles, shape.truth_vertices.shape[0])
+    verdict = homeomorphic(sig, truth)
+    assert verdict, verdict.reasons
+    st_ = mesh_stats(rec.triangles, rec.vertices.shape[0])
+    assert st_.overloaded_edges == 0
+    assert st_.used_vertices == points.shape[0]
+    assert self_intersections(rec.vertices, rec.triangles).shape[0] == 0
+    fid = hausdorff(
+        rec.vertices, rec.triangles, shape.truth_vertices, shape.truth_triangles, samples=2000
+    )
+    assert fid.hausdorff <= spacing, f"Hausdorff {fid.hausdorff / spacing:.2f} h"

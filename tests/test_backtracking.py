@@ -117,6 +117,9 @@ def test_bad_arguments():
     cyc = trivial_isometric_cycles(e, len(pts))
     with pytest.raises(InputError, match="budget must be a positive integer, got 0"):
         backtracking(pts, e, cyc, budget=0)
+    for seconds in (-1.0, float("nan"), float("inf"), "5"):
+        with pytest.raises(InputError, match="exact_seconds must be a finite number >= 0"):
+            backtracking(pts, e, cyc, exact_seconds=seconds)
     bad = CycleSet(np.array([0, 3]), np.array([0, 1, 25]))
     with pytest.raises(InputError, match="cycles use a pair of points that is not an edge"):
         backtracking(pts, e, bad)

@@ -25,11 +25,10 @@ from sr33 import InputError, Reconstruction, localized_rng, reconstruct  # noqa:
 from sr33.samplers import cube_lattice, shapes  # noqa: E402
 from sr33.samplers.scanline import scan  # noqa: E402
 from sr33.validators import mesh_stats  # noqa: E402
-from sr33.validators.fidelity import hausdorff  # noqa: E402
 from sr33.validators.intersections import self_intersections  # noqa: E402
 from sr33.validators.signature import homeomorphic, signature  # noqa: E402
 from tests.fuzzstats import count  # noqa: E402
-from tests.helpers import triangle_set  # noqa: E402
+from tests.helpers import check_homeomorphism, triangle_set  # noqa: E402
 from tests.strategies import (  # noqa: E402
     ACUTE_SHAPES,
     arbitrary_points,
@@ -56,24 +55,6 @@ def sample_shape(name, params, cfg):
         repair=False,
     )
     return s, r
-
-
-def check_homeomorphism(shape, points: np.ndarray, spacing: float, rec: Reconstruction) -> None:
-    """The homeomorphism guarantee: same signature as the shape, no open or
-    overloaded edges beyond the shape's boundary, disjoint interiors, every
-    sample used, Hausdorff distance to the truth at most h."""
-    sig = signature(rec.triangles, rec.vertices.shape[0], points=rec.vertices)
-    truth = signature(shape.truth_triangles, shape.truth_vertices.shape[0])
-    verdict = homeomorphic(sig, truth)
-    assert verdict, verdict.reasons
-    st_ = mesh_stats(rec.triangles, rec.vertices.shape[0])
-    assert st_.overloaded_edges == 0
-    assert st_.used_vertices == points.shape[0]
-    assert self_intersections(rec.vertices, rec.triangles).shape[0] == 0
-    fid = hausdorff(
-        rec.vertices, rec.triangles, shape.truth_vertices, shape.truth_triangles, samples=2000
-    )
-    assert fid.hausdorff <= spacing, f"Hausdorff {fid.hausdorff / spacing:.2f} h"
 
 
 def _homeomorphism_case(name, data):
