@@ -64,7 +64,7 @@ from scipy.sparse import csgraph
 from . import _kernels
 from ._validate import InputError, as_edges, as_points
 from .cycles import CycleSet
-from .graph import cycle_edges, lookup_edges
+from .graph import cycle_edges, link_is_disk, lookup_edges
 from .mesh import self_intersections, unique_edges, unique_rows
 from .progress import bar
 from .rng import Neighbourhoods, k_neighbourhoods
@@ -293,34 +293,6 @@ def links_are_disks(n: int, vertex, prev, nxt) -> np.ndarray:
     return has & (comps == 1) & ~bad_deg & ~loops
 
 
-def _link_is_disk(corners: list[tuple[int, int]]) -> bool:
-    """True when the corner pairs (prev, next) at a vertex form one path or one cycle."""
-    if not corners:
-        return False
-    deg: dict[int, int] = {}
-    adj: dict[int, list[int]] = {}
-    for p, q in corners:
-        if p == q:
-            return False
-        deg[p] = deg.get(p, 0) + 1
-        deg[q] = deg.get(q, 0) + 1
-        adj.setdefault(p, []).append(q)
-        adj.setdefault(q, []).append(p)
-    if max(deg.values()) > 2:
-        return False
-    # connected?
-    start = next(iter(adj))
-    seen = {start}
-    stack = [start]
-    while stack:
-        x = stack.pop()
-        for y in adj[x]:
-            if y not in seen:
-                seen.add(y)
-                stack.append(y)
-    return len(seen) == len(adj)
-
-
 def _link_is_partial_ok(corners: list[tuple[int, int]]) -> bool:
     """True when corner pairs can still grow into one disk: paths, or one lone cycle."""
     if not corners:
@@ -337,7 +309,7 @@ def _link_is_partial_ok(corners: list[tuple[int, int]]) -> bool:
     n_edges = len(corners)
     n_nodes = len(deg)
     if n_edges >= n_nodes:  # contains a cycle
-        return _link_is_disk(corners)
+        return link_is_disk(corners)
     return True
 
 
@@ -420,7 +392,7 @@ def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
             if on:
                 pairs.append((int(prob.corner_prev[k]), int(prob.corner_next[k])))
         if vrem[v] == 0:
-            return _link_is_disk(pairs)
+            return link_is_disk(pairs)
         return _link_is_partial_ok(pairs)
 
     def assign(c, val, queue_e, queue_v):

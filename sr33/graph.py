@@ -37,3 +37,37 @@ def lookup_edges(edges: np.ndarray, pairs: np.ndarray, n: int) -> np.ndarray:
     found = keys.shape[0] > 0
     ok = (keys[pos] == q) if found else np.zeros(q.shape, bool)
     return np.where(ok, pos, -1)
+
+
+def link_is_disk(corners: list[tuple[int, int]]) -> bool:
+    """True when the corner pairs (prev, next) at a vertex form one path or one cycle.
+
+    The vertex form of the success condition of Algorithm 4 (Section 4): the
+    faces round a sample make a disk exactly when their corners there, as
+    edges between its neighbours, form one path (a boundary sample) or one
+    cycle.  An empty link is not a disk.
+    """
+    if not corners:
+        return False
+    deg: dict[int, int] = {}
+    adj: dict[int, list[int]] = {}
+    for p, q in corners:
+        if p == q:
+            return False
+        deg[p] = deg.get(p, 0) + 1
+        deg[q] = deg.get(q, 0) + 1
+        adj.setdefault(p, []).append(q)
+        adj.setdefault(q, []).append(p)
+    if max(deg.values()) > 2:
+        return False
+    # connected?
+    start = next(iter(adj))
+    seen = {start}
+    stack = [start]
+    while stack:
+        x = stack.pop()
+        for y in adj[x]:
+            if y not in seen:
+                seen.add(y)
+                stack.append(y)
+    return len(seen) == len(adj)

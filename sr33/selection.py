@@ -50,6 +50,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
+from .graph import link_is_disk
 from .progress import log
 
 #: deterministic-time units per second of budget (CP-SAT's deterministic
@@ -192,27 +193,7 @@ def _link_ok(tab: _Tables, state: np.ndarray, v: int) -> bool:
         for k in tab.corners_at(v)
         if state[tab.corner_owner[k]] == 1
     ]
-    if not pairs:
-        return True
-    deg: dict[int, int] = {}
-    adj: dict[int, list[int]] = {}
-    for p, q in pairs:
-        if p == q:
-            return False
-        for a, b in ((p, q), (q, p)):
-            deg[a] = deg.get(a, 0) + 1
-            adj.setdefault(a, []).append(b)
-    if max(deg.values()) > 2:
-        return False
-    start = next(iter(adj))
-    seen = {start}
-    stack = [start]
-    while stack:
-        for y in adj[stack.pop()]:
-            if y not in seen:
-                seen.add(y)
-                stack.append(y)
-    return len(seen) == len(adj)
+    return not pairs or link_is_disk(pairs)
 
 
 def _bubbles(tab: _Tables, state: np.ndarray, cycles, outside_faces: bool) -> list[list[int]]:
