@@ -68,7 +68,7 @@ from .graph import cycle_edges, link_is_disk, lookup_edges
 from .mesh import self_intersections, unique_edges, unique_rows
 from .progress import bar
 from .rng import Neighbourhoods, k_neighbourhoods
-from .selection import ExactReport, exact_selection
+from .selection import ExactReport, Incidence, exact_selection
 from .tolerance import DEFAULT, Tolerance
 
 
@@ -745,7 +745,7 @@ def backtracking(
         for a, b in _crossing_pairs(pts, cycles, centroid, mask).tolist():
             exact_conflicts.setdefault(int(a), []).append(int(b))
             exact_conflicts.setdefault(int(b), []).append(int(a))
-        exact = exact_selection(
+        incidence = Incidence(
             prob.cycle_edge_ids,
             prob.cycle_vertices,
             prob.corner_owner,
@@ -754,6 +754,9 @@ def backtracking(
             prob.corner_next,
             e,
             n,
+        )
+        exact = exact_selection(
+            incidence,
             state,
             region,
             exact_conflicts,

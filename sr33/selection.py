@@ -103,40 +103,57 @@ class _Tables:
         return vc.data[vc.indptr[v] : vc.indptr[v + 1]] - 1
 
 
-def _tables(
-    cycle_edge_ids,
-    cycle_vertices,
-    corner_owner,
-    corner_vertex,
-    corner_prev,
-    corner_next,
-    n_edges,
-    n_points,
-    edges,
-) -> _Tables:
-    owner = np.repeat(np.arange(len(cycle_edge_ids)), [len(c) for c in cycle_edge_ids])
-    flat = np.concatenate(cycle_edge_ids) if len(cycle_edge_ids) else np.empty(0, np.int64)
+@dataclass(frozen=True)
+class Incidence:
+    """The candidate cycles as :func:`exact_selection` reads them.
+
+    Attributes
+    ----------
+    cycle_edge_ids, cycle_vertices : list of (L,) int64 arrays
+        Every candidate cycle's edge ids and vertices.
+    corner_owner, corner_vertex, corner_prev, corner_next : (s,) int64
+        Every corner (cycle, vertex, previous and next vertex on the cycle).
+    edges : (m, 2) int64
+        The graph's edges (sorted rows), indexed by the edge ids.
+    n_points : int
+        Number of samples.
+    """
+
+    cycle_edge_ids: list
+    cycle_vertices: list
+    corner_owner: np.ndarray
+    corner_vertex: np.ndarray
+    corner_prev: np.ndarray
+    corner_next: np.ndarray
+    edges: np.ndarray
+    n_points: int
+
+
+def _tables(inc: Incidence) -> _Tables:
+    ids = inc.cycle_edge_ids
+    owner = np.repeat(np.arange(len(ids)), [len(c) for c in ids])
+    flat = np.concatenate(ids) if len(ids) else np.empty(0, np.int64)
+    edges = np.asarray(inc.edges, dtype=np.int64).reshape(-1, 2)
     ec = sparse.csr_matrix(
-        (np.ones(flat.shape[0], dtype=np.int8), (flat, owner)),
-        shape=(n_edges, len(cycle_edge_ids)),
+        (np.ones(flat.shape[0], dtype=np.int8), (flat, owner)), shape=(edges.shape[0], len(ids))
     )
     ec.sort_indices()
-    s = corner_vertex.shape[0]
+    s = inc.corner_vertex.shape[0]
     vc = sparse.csr_matrix(
-        (np.arange(1, s + 1), (corner_vertex, np.arange(s))), shape=(n_points, s)
+        (np.arange(1, s + 1), (inc.corner_vertex, np.arange(s))), shape=(inc.n_points, s)
     )
     vc.sort_indices()
-    edge_of = {(int(a), int(b)): i for i, (a, b) in enumerate(np.asarray(edges).tolist())}
+    edge_of = {(int(a), int(b)): i for i, (a, b) in enumerate(edges.tolist())}
     return _Tables(
-        list(cycle_edge_ids),
-        list(cycle_vertices),
+        list(ids),
+        list(inc.cycle_vertices),
         ec,
         vc,
-        corner_owner,
-        corner_prev,
-        corner_next,
+        inc.corner_owner,
+        inc.corner_prev,
+        inc.corner_next,
         edge_of,
-        n_points,
+        inc.n_points,
     )
 
 
@@ -485,14 +502,7 @@ def _solve_component(
 
 
 def exact_selection(
-    cycle_edge_ids,
-    cycle_vertices,
-    corner_owner,
-    corner_vertex,
-    corner_prev,
-    corner_next,
-    edges,
-    n_points: int,
+    incidence: Incidence,
     state: np.ndarray,
     region: np.ndarray,
     conflicts: dict[int, list[int]],
@@ -505,14 +515,8 @@ def exact_selection(
 
     Parameters
     ----------
-    cycle_edge_ids, cycle_vertices : list of (L,) int64 arrays
-        Every candidate cycle's edge ids and vertices.
-    corner_owner, corner_vertex, corner_prev, corner_next : (s,) int64
-        Every corner (cycle, vertex, previous and next vertex on the cycle).
-    edges : (m, 2) int64
-        The graph's edges (sorted rows), indexed by the edge ids.
-    n_points : int
-        Number of samples.
+    incidence : Incidence
+        The candidate cycles, their edges and corners.
     state : (c,) int64
         1 for a selected cycle, 0 otherwise; cycles of ``region`` are
         re-decided, the others are held fixed.
@@ -533,18 +537,8 @@ def exact_selection(
     -------
     ExactReport
     """
-    edges = np.asarray(edges, dtype=np.int64)
-    tab = _tables(
-        cycle_edge_ids,
-        cycle_vertices,
-        corner_owner,
-        corner_vertex,
-        corner_prev,
-        corner_next,
-        edges.shape[0],
-        n_points,
-        edges,
-    )
+    tab = _tables(incidence)
+    n_points = incidence.n_points
     region = np.unique(np.asarray(region, dtype=np.int64))
     if region.shape[0] == 0:
         return ExactReport(0, 0, 0, 0)
