@@ -2,18 +2,21 @@
 
 Theorem 5 leaves a defect: the output need not use every sample.  The paper
 remedies it by attaching stray samples with cones whose triangles keep
-interiors disjoint.  Here a stray sample p is coned over the triangle t
-nearest to it: t is replaced by the three triangles joining p to t's edges.
-That is a subdivision of t, so the topology of the surface is unchanged;
-orientation is inherited from t.  A stray far from t's plane (the samples
-of an acute sharp edge that a closed selection bevelled) makes a tent whose
-sides can cross their neighbours', so the cones are followed by edge flips
-round the attached samples (:func:`flip_sharper`) that lower the total
-absolute curvature (edge length times the angle between its triangles'
-normals; after Dyn, Hormann, Kim and Levin 2001, *Optimizing 3D
-triangulations using discrete curvature analysis*), when the new triangles
-cross no triangle near them: that puts a bevelled edge's samples back on
-one sharp edge.  A flip keeps the topology too.
+interiors disjoint.  Here a stray sample p is inserted where it is nearest:
+into a triangle t (t is replaced by the three triangles joining p to t's
+edges, a cone) or onto an edge e of two triangles (they are replaced by the
+four joining p to their sides: the way back onto a sharp edge that a closed
+selection bevelled, whose samples sit above the bevel's chords).  Both are
+subdivisions, so the topology of the surface is unchanged; orientation is
+inherited.  Options are tried nearest first and the first whose new
+triangles have area and cross no triangle near them is taken (if none, the
+nearest with area).  Then edge flips round the attached samples
+(:func:`flip_sharper`) lower the total absolute curvature (edge length
+times the angle between its triangles' normals; after Dyn, Hormann, Kim and
+Levin 2001, *Optimizing 3D triangulations using discrete curvature
+analysis*), when the new triangles cross no triangle near them: that puts a
+bevelled edge's samples back on one sharp edge.  A flip keeps the topology
+too.
 """
 
 from __future__ import annotations
@@ -86,7 +89,7 @@ def ring_centres(points, faces) -> dict[int, int]:
 def attach_cones(
     points, triangles, *, candidates: int = 16, flips: bool = True
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Attach every sample no triangle uses, by a cone over its nearest triangle.
+    """Attach every sample no triangle uses, by a triangle or edge split near it.
 
     Parameters
     ----------
@@ -95,7 +98,8 @@ def attach_cones(
     triangles : (t, 3) array_like of int
         The triangulated output.
     candidates : int
-        How many triangles (nearest by centroid) are searched per stray sample.
+        How many input triangles (nearest by centroid) are searched per stray
+        sample, with the triangles they have been split into since.
     flips : bool
         Follow the cones by :func:`flip_sharper` round the attached samples.
 

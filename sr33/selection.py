@@ -53,8 +53,9 @@ from scipy.sparse import csgraph
 from .graph import link_is_disk
 from .progress import log
 
-#: deterministic-time units per second of budget (CP-SAT's deterministic
-#: time is close to seconds of one core on this kind of model)
+#: CP-SAT deterministic time per second of ``seconds``: on these models one
+#: deterministic unit took about four seconds of one core, so ``seconds`` is
+#: close to wall-clock seconds (the limit itself is machine-independent)
 _DET_PER_SECOND = 0.25
 
 
@@ -509,7 +510,6 @@ def exact_selection(
     *,
     seconds: float = 5.0,
     max_rounds: int = 40,
-    all_links: bool = False,
 ) -> ExactReport:
     """Select the faces of ``region`` exactly; updates ``state`` in place.
 
@@ -530,8 +530,6 @@ def exact_selection(
         lazy rounds).
     max_rounds : int
         Lazy rounds per component.
-    all_links : bool
-        Add every sample's link constraint up front instead of lazily.
 
     Returns
     -------
@@ -558,7 +556,7 @@ def exact_selection(
     for comp in comps:
         edges_ = sorted({int(e) for c in comp for e in tab.cycle_edges[c]})
         verts_ = sorted({int(v) for c in comp for v in tab.cycle_vertices[c]})
-        links = set(verts_) if all_links else set()
+        links: set[int] = set()  # lazily (all up front: 2x slower, no better)
         before = _score(tab, state, comp, edges_, verts_, lone)
         for allow_open in (False, True):
             # coverage first (fast, proven on the library shapes), then the
