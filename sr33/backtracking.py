@@ -738,13 +738,15 @@ def backtracking(
     lone_edge = prob.n_cycles_at_edge == 1
     if failed and exact_seconds > 0:
         region = _region(prob, failed, lone_edge, n)
-        # the region's fixed cycles were not free: their crossings are new
+        # the region's fixed cycles were not free: only their crossings are new
         mask = np.zeros(nc, dtype=bool)
         mask[region] = True
+        mask &= ~free
         exact_conflicts = {c: list(d) for c, d in conflicts.items()}
         for a, b in _crossing_pairs(pts, cycles, centroid, mask).tolist():
-            exact_conflicts.setdefault(int(a), []).append(int(b))
-            exact_conflicts.setdefault(int(b), []).append(int(a))
+            if b not in exact_conflicts.get(a, ()):
+                exact_conflicts.setdefault(int(a), []).append(int(b))
+                exact_conflicts.setdefault(int(b), []).append(int(a))
         incidence = Incidence(
             prob.cycle_edge_ids,
             prob.cycle_vertices,

@@ -161,11 +161,10 @@ def attach_cones(
         _, near = tree.query(pts[p], kq)
         cand = sorted({j for o in np.atleast_1d(near).tolist() for j in family[o]})
         options = _insertions(pts, p, cand, tris, owner)
+        solid = [o for o in options if not _flat(pts, o[2])] or options
         local = np.array([tris[i] for i in cand], dtype=np.int64)
         pick = None
-        for _, old, new in options:
-            if _flat(pts, new):
-                continue
+        for _, old, new in solid:
             keep_i = [k for k, i in enumerate(cand) if i not in old]
             patch = np.vstack([np.array(new, dtype=np.int64), local[keep_i]])
             m = len(new)
@@ -174,7 +173,6 @@ def attach_cones(
                 pick = (old, new)
                 break
         if pick is None:  # every insertion crosses something: the nearest one
-            solid = [o for o in options if not _flat(pts, o[2])] or options
             pick = solid[0][1:]
         old, new = pick
         o0, o1 = origin[old[0]], origin[old[-1]]

@@ -369,10 +369,7 @@ def _solve_component(
         )
     m.Minimize(obj)
 
-    linked: set[int] = set()
-
     def add_link(v: int) -> None:
-        linked.add(v)
         links.add(v)
         ks = tab.corners_at(v)
         node: dict[int, int] = {}
@@ -459,7 +456,7 @@ def _solve_component(
         trial = state.copy()
         for c in cycles:
             trial[c] = int(solver.Value(x[c]))
-        bad = [v for v in verts if v not in linked and not _link_ok(tab, trial, v)]
+        bad = [v for v in verts if v not in links and not _link_ok(tab, trial, v)]
         bubbles = _bubbles(tab, trial, cycles, outside)
         for v in bad:
             add_link(v)
