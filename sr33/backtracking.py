@@ -111,6 +111,9 @@ class FaceSelection:
     exact : ExactReport
         What the exact selection (:mod:`sr33.selection`) did on the
         components the strict search failed.
+    true_boundary : (p,) bool
+        For every row of ``open_edges``, whether it lies in one candidate
+        cycle only (a true boundary in the success condition).
     """
 
     faces: CycleSet
@@ -124,6 +127,7 @@ class FaceSelection:
     non_disk_neighbourhoods: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64))
     notes: tuple[str, ...] = field(default=())
     exact: ExactReport = field(default_factory=lambda: ExactReport(0, 0, 0, 0))
+    true_boundary: np.ndarray = field(default_factory=lambda: np.empty(0, bool))
 
 
 def _cycle_geometry(points, cs: CycleSet):
@@ -826,4 +830,5 @@ def backtracking(
         non_disk_neighbourhoods=non_disk,
         notes=tuple(notes),
         exact=exact,
+        true_boundary=lone_edge[use == 1],
     )

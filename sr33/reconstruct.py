@@ -16,7 +16,9 @@ from ._validate import as_points, check_k, check_max_cycle_length, check_not_deg
 from .backtracking import backtracking
 from .cones import attach_cones, ring_centres
 from .cycles import CycleSet, trivial_isometric_cycles
-from .mesh import self_intersections
+from .graph import cycle_edges
+from .holes import HoleLoops, concat, face_links, hole_loops, uncovered
+from .mesh import edge_keys, self_intersections
 from .progress import log, timed
 from .rng import localized_rng
 from .selfcheck import check_faces_and_triangles, strict_default
@@ -65,6 +67,9 @@ class Reconstruction:
         Ambiguous components where the strict search failed; the greedy
         fallback and then the exact selection (:mod:`sr33.selection`)
         decided them.
+    hole_faces : int
+        Boundary loops of the selection closed by one face each
+        (:mod:`sr33.holes`); they are the last cycles of ``face_cycles``.
     timings : dict[str, float]
         Seconds per step.
     k : int
@@ -85,6 +90,7 @@ class Reconstruction:
     non_disk_neighbourhoods: np.ndarray
     coned_samples: np.ndarray
     fallback_components: int
+    hole_faces: int = 0
     timings: dict[str, float] = field(default_factory=dict)
     k: int = 33
 
@@ -107,6 +113,67 @@ def _canonical_order(uniq, first, inverse):
     return uniq[order], first[order], back[inverse]
 
 
+def _edge_use(faces: CycleSet, n: int) -> tuple[np.ndarray, int]:
+    """Edges used by one face cycle (rows (a, b), a < b, sorted) and the
+    number of edges used more than twice."""
+    if len(faces) == 0:
+        return np.empty((0, 2), np.int64), 0
+    pairs, _ = cycle_edges(faces.offsets, faces.vertices)
+    keys, cnt = np.unique(edge_keys(pairs[:, 0], pairs[:, 1], n), return_counts=True)
+    once = keys[cnt == 1]
+    return np.stack([once // n, once % n], axis=1).astype(np.int64), int((cnt > 2).sum())
+
+
+def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolerance: Tolerance):
+    """Triangulate the selection plus the boundary loops that stay valid.
+
+    A loop face is dropped when its triangles are not covered by the samples
+    or cross another triangle (:mod:`sr33.holes`); then a ring-centre fan
+    that crosses another triangle (a bevelled acute edge's sample under a
+    quad) gives its sample back to the cones, which insert it where nothing
+    crosses.  Returns the faces, their triangulation, the centres used and
+    the number of loop faces kept.
+    """
+    nb = len(base)
+    loops = holes.loops if holes is not None else None
+    active = list(range(len(loops))) if loops is not None else []
+    no_centre: set[tuple[str, int]] = set()
+    rounds = 0
+    while True:
+        faces = concat(base, loops.subset(np.array(active, dtype=np.int64))) if active else base
+        key = [("f", i) for i in range(nb)] + [("l", i) for i in active]
+        centres = {f: c for f, c in ring_centres(pts, faces).items() if key[f] not in no_centre}
+        tr = triangulate(pts, faces, rtol=tolerance.rtol, centres=centres)
+        fot = tr.face_of_triangle
+        hits = self_intersections(pts, tr.triangles)
+        crossing = set(fot[hits.ravel()].tolist())
+        drop = {f for f in crossing if f >= nb}
+        if active:
+            is_loop = fot >= nb
+            sub = faces.subset(np.arange(nb, len(faces)))
+            ends = np.roll(np.arange(sub.vertices.shape[0]), -1)
+            ends[sub.offsets[1:] - 1] = sub.offsets[:-1]
+            el = np.linalg.norm(pts[sub.vertices] - pts[sub.vertices[ends]], axis=1)
+            scale = np.maximum.reduceat(el, sub.offsets[:-1])
+            bad = uncovered(pts, tr.triangles[is_loop], fot[is_loop] - nb, scale)
+            drop |= {nb + int(i) for i in np.flatnonzero(bad)}
+        if drop:
+            log.debug(
+                "hole loops: %d of %d dropped (%d crossing)",
+                len(drop),
+                len(active),
+                len({f for f in crossing if f >= nb}),
+            )
+            active = [a for j, a in enumerate(active) if nb + j not in drop]
+            continue
+        bad_centres = crossing & set(centres)
+        rounds += 1
+        if not bad_centres or rounds > 3:
+            break
+        no_centre |= {key[f] for f in bad_centres}
+    return faces, tr, centres, len(active)
+
+
 def reconstruct(
     points,
     k: int = 33,
@@ -114,6 +181,7 @@ def reconstruct(
     max_cycle_length: int = 8,
     budget: int = 20000,
     exact_seconds: float = 5.0,
+    max_hole_length: int = 66,
     tolerance: Tolerance = DEFAULT,
     quiet: bool = True,
     strict: bool | None = None,
@@ -134,6 +202,9 @@ def reconstruct(
     exact_seconds : float
         Budget of the exact selection per region the search failed on (see
         :mod:`sr33.selection`); 0 keeps the greedy fallback's answer.
+    max_hole_length : int
+        Longest boundary loop of the selection that may be closed by one
+        face (:mod:`sr33.holes`); 0 closes none.
     tolerance : Tolerance
         Tie and fold tolerances (:mod:`sr33.tolerance`).
     quiet : bool
@@ -187,22 +258,10 @@ def reconstruct(
             exact_seconds=exact_seconds,
             quiet=quiet,
         )
+    with timed("hole_loops", timings):
+        holes = hole_loops(pts, sel.faces, max_length=max_hole_length) if max_hole_length else None
     with timed("triangulate", timings):
-        faces = sel.faces
-        centres = ring_centres(pts, faces)
-        tr = triangulate(pts, faces, rtol=tolerance.rtol, centres=centres)
-        for _ in range(3):
-            if not centres:
-                break
-            # a ring-centre fan that crosses another triangle (a bevelled
-            # acute edge's sample under a quad) gives its sample back to the
-            # cones, which insert it where nothing crosses
-            hits = self_intersections(pts, tr.triangles)
-            bad = set(tr.face_of_triangle[hits.ravel()].tolist()) & set(centres)
-            if not bad:
-                break
-            centres = {f: c for f, c in centres.items() if f not in bad}
-            tr = triangulate(pts, faces, rtol=tolerance.rtol, centres=centres)
+        faces, tr, centres, n_loops = _triangulate_with_loops(pts, sel.faces, holes, tolerance)
         tri = tr.triangles
     if strict_default() if strict is None else strict:
         with timed("self_checks", timings):
@@ -218,7 +277,21 @@ def reconstruct(
     relabel[out_order] = np.arange(out_order.shape[0])
     rng_edges = np.sort(relabel[rng.edges], axis=1)
     rng_edges = rng_edges[np.lexsort((rng_edges[:, 1], rng_edges[:, 0]))]
-    open_edges = np.sort(relabel[sel.open_edges], axis=1) if sel.open_edges.size else sel.open_edges
+    # the success condition and its figures on the final faces (loops included)
+    still_open, over = _edge_use(faces, pts.shape[0])
+    was_open = edge_keys(sel.open_edges[:, 0], sel.open_edges[:, 1], pts.shape[0])
+    now_open = edge_keys(still_open[:, 0], still_open[:, 1], pts.shape[0])
+    bad_open = was_open[~sel.true_boundary]
+    disk = face_links(pts.shape[0], faces) if len(faces) else np.zeros(pts.shape[0], bool)
+    used = np.zeros(pts.shape[0], dtype=bool)
+    used[faces.vertices] = True
+    success = bool(
+        len(faces) > 0
+        and over == 0
+        and not np.any(used & ~disk)
+        and not np.isin(now_open, bad_open).any()
+    )
+    open_edges = np.sort(relabel[still_open], axis=1) if still_open.size else still_open
     faces = CycleSet(offsets=faces.offsets, vertices=relabel[faces.vertices])
     return Reconstruction(
         vertices=pts[out_order],
@@ -228,13 +301,14 @@ def reconstruct(
         rng_edges=rng_edges,
         candidate_cycles=len(cycles),
         face_cycles=faces,
-        success=bool(sel.success and tr.orientable),
+        success=bool(success and tr.orientable),
         orientable=bool(tr.orientable),
         open_edges=open_edges,
-        unresolved_samples=np.sort(relabel[sel.unresolved_samples]),
+        unresolved_samples=np.sort(relabel[np.flatnonzero(~disk)]),
         non_disk_neighbourhoods=np.sort(relabel[sel.non_disk_neighbourhoods]),
         coned_samples=np.sort(relabel[np.r_[coned, list(centres.values())].astype(np.int64)]),
         fallback_components=sel.fallback_components,
+        hole_faces=n_loops,
         timings=timings,
         k=k,
     )

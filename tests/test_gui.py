@@ -16,7 +16,8 @@ from sr33.cli import main  # noqa: E402
 from sr33.gui import COLOURS, LAYERS, Inspector  # noqa: E402
 from sr33.io import load_reconstruction, read_points, save_reconstruction  # noqa: E402
 from sr33.samplers import cube_lattice  # noqa: E402
-from tests.helpers import PAPER_SMALL, need  # noqa: E402
+from sr33.validators import mesh_stats  # noqa: E402
+from tests.helpers import PAPER_SMALL, need, triangle_set  # noqa: E402
 
 
 def red_pixels(img):
@@ -68,17 +69,21 @@ def test_k_slider_reruns_and_changes_the_figures():
     pts = read_points(need(PAPER_SMALL / "cutcube.obj"))
     p = plotter()
     ins = Inspector(p, pts, k=16)
-    before = dict(ins.state.figures)
+    before = triangle_set(ins.rec.triangles)
     camera = list(p.camera_position)
     # drive the slider widget itself: set its value and fire its end event
     p.render()
     p.iren.initialize()
     rep = ins._slider.GetRepresentation()
-    rep.SetValue(4)  # too small a k for these samples: open edges
+    rep.SetValue(4)  # a k this small closes its last hole with a loop face
     ins._slider.InvokeEvent("EndInteractionEvent")
-    assert ins.state.k == 4
-    assert ins.state.figures != before
-    assert ins.state.figures["open_edges"] > 0 and before["open_edges"] == 0
+    assert ins.state.k == 4 and ins.rec.k == 4
+    assert ins.rec.hole_faces >= 1
+    assert triangle_set(ins.rec.triangles) != before
+    assert ins.state.figures == {
+        **ins.state.figures,
+        **mesh_stats(ins.rec.triangles, ins.rec.vertices.shape[0]).as_dict(),
+    }
     assert [tuple(x) for x in p.camera_position] == [tuple(x) for x in camera]
 
 

@@ -1,0 +1,269 @@
+"""Boundary loops of the selection as faces (Section 4, proof of Theorem 4).
+
+Candidate face cycles stop at ``max_cycle_length`` edges, so where the
+search could not close the surface with small cycles (real scans with
+uneven density, thin parts) the selection keeps holes whose boundary loops
+are 9-100 edges long.  The proof of Theorem 4 closes a troubled
+neighbourhood with the isometric loop around it as one face; this module
+does that for the loops the selection leaves open.
+
+A loop becomes a face only when all of these hold:
+
+* it is a simple cycle of open edges (each sample once), read off the
+  oriented faces: at a sample where the boundary passes more than once, an
+  incoming boundary edge continues with an outgoing one from another piece
+  of the sample's link (so that filling every loop there closes the link);
+* it has at most ``max_length`` edges (the minimum-area triangulation is
+  O(L³));
+* adding it leaves the link of every sample that was a disk a disk;
+* it does not close a small piece on its own: its triangulation's area is
+  less than the area of the faces it borders (no detached bubble);
+* its triangulation is *covered by the samples*: every centroid and edge
+  midpoint of its triangles is within ``cover`` times the loop's longest
+  edge of some sample.  Under the paper's dense-sampling conditions every
+  point of the surface is that close to a sample, so a loop round an empty
+  region (the rim of a sheet, a true hole) is a boundary and stays open,
+  while the narrow slits and the holes round stray samples that the
+  selection leaves are closed;
+* its triangles cross no other triangle (checked by the caller after
+  triangulation, :func:`sr33.reconstruct.reconstruct`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse import csgraph
+from scipy.spatial import cKDTree
+
+from .backtracking import links_are_disks
+from .cycles import CycleSet
+from .graph import cycle_edges
+from .mesh import edge_keys
+
+
+@dataclass(frozen=True)
+class HoleLoops:
+    """Result of :func:`hole_loops`.
+
+    Attributes
+    ----------
+    loops : CycleSet
+        The boundary loops that may become faces (canonical cycle form).
+    found : int
+        Boundary loops of the selection (simple or not).
+    """
+
+    loops: CycleSet
+    found: int
+
+
+def _canonical(cyc: list[int]) -> list[int]:
+    """Start at the smallest vertex, second vertex smaller than the last."""
+    i = cyc.index(min(cyc))
+    c = cyc[i:] + cyc[:i]
+    if c[1] > c[-1]:
+        c = [c[0]] + c[1:][::-1]
+    return c
+
+
+def _corners(faces: CycleSet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertex, prev, next) of every corner of every cycle."""
+    pairs, owner = cycle_edges(faces.offsets, faces.vertices)
+    prev = np.roll(np.arange(faces.vertices.shape[0]), 1)
+    prev[faces.offsets[:-1]] = faces.offsets[1:] - 1
+    return faces.vertices, faces.vertices[prev], pairs[:, 1]
+
+
+def concat(a: CycleSet, b: CycleSet) -> CycleSet:
+    """The cycles of ``a`` followed by those of ``b``."""
+    return CycleSet(
+        offsets=np.concatenate([a.offsets, a.offsets[-1] + b.offsets[1:]]).astype(np.int64),
+        vertices=np.concatenate([a.vertices, b.vertices]).astype(np.int64),
+    )
+
+
+def face_links(n: int, faces: CycleSet) -> np.ndarray:
+    """For every sample, whether the faces' corners at it form a disk."""
+    v, p, q = _corners(faces)
+    return links_are_disks(n, v, p, q)
+
+
+def _area(points, cyc) -> float:
+    """Area of a fan triangulation of a cycle (a cheap size estimate)."""
+    p = points[cyc]
+    return float(0.5 * np.linalg.norm(np.cross(p[1:-1] - p[0], p[2:] - p[0]), axis=1).sum())
+
+
+def hole_loops(points, faces: CycleSet, *, max_length: int = 66) -> HoleLoops:
+    """The open boundary loops of a face selection that may be closed by one face.
+
+    Parameters
+    ----------
+    points : (n, 3) float64
+        The samples.
+    faces : CycleSet
+        The selected face cycles (:attr:`sr33.FaceSelection.faces`).
+    max_length : int
+        Longest loop considered.
+
+    Returns
+    -------
+    HoleLoops
+        The loops passing the combinatorial tests of the module docstring
+        (simple, short enough, links kept disks, no bubble); coverage and
+        crossings are tested on their triangulation by the caller.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    n = pts.shape[0]
+    empty = HoleLoops(CycleSet(np.zeros(1, np.int64), np.empty(0, np.int64)), 0)
+    if len(faces) == 0:
+        return empty
+    oriented = faces
+    pairs, owner = cycle_edges(faces.offsets, faces.vertices)
+    keys = edge_keys(pairs[:, 0], pairs[:, 1], n)
+    _, inv, cnt = np.unique(keys, return_inverse=True, return_counts=True)
+    once = cnt[inv] == 1
+    if not once.any():
+        return empty
+    # the open edges, each with the face that uses it
+    hole = np.sort(pairs[once], axis=1)
+    hole_owner = owner[once]
+    order = np.lexsort((hole[:, 1], hole[:, 0]))
+    hole, hole_owner = hole[order], hole_owner[order]
+    at: dict[int, list[int]] = {}
+    for a, b in hole.tolist():
+        at.setdefault(a, []).append(b)
+        at.setdefault(b, []).append(a)
+    # at every sample, which open neighbour the loop continues to from another
+    v_all, p_all, q_all = _corners(faces)
+    corner_order = np.argsort(v_all, kind="stable")
+    starts = np.searchsorted(v_all[corner_order], np.arange(n + 1))
+    partner: dict[tuple[int, int], int] = {}
+    for v, nbrs in at.items():
+        nbrs = sorted(nbrs)
+        if len(nbrs) % 2:
+            continue  # an odd boundary vertex (an edge used by three faces near it)
+        if len(nbrs) == 2:
+            partner[(v, nbrs[0])], partner[(v, nbrs[1])] = nbrs[1], nbrs[0]
+            continue
+        # pieces of v's link: neighbours joined by corners at v; a loop
+        # passing v joins the ends of two different pieces
+        piece: dict[int, int] = {}
+
+        def find(x: int, piece=piece) -> int:
+            while piece.setdefault(x, x) != x:
+                x = piece[x]
+            return x
+
+        for k in corner_order[starts[v] : starts[v + 1]].tolist():
+            piece[find(int(p_all[k]))] = find(int(q_all[k]))
+        free = list(nbrs)
+        while free:
+            x = free.pop(0)
+            other = [y for y in free if find(y) != find(x)]
+            y = (other or free)[0]
+            free.remove(y)
+            partner[(v, x)], partner[(v, y)] = y, x
+    edge_row = {(a, b): i for i, (a, b) in enumerate(hole.tolist())}
+    seen = np.zeros(hole.shape[0], dtype=bool)
+    found = 0
+    loops: list[list[int]] = []
+    loop_owner: list[np.ndarray] = []
+    for s in range(hole.shape[0]):
+        if seen[s]:
+            continue
+        a, b = (int(x) for x in hole[s])
+        cyc, rows = [a], [s]
+        seen[s] = True
+        closed = False
+        while True:
+            cyc.append(b)
+            c = partner.get((b, a))
+            if c is None:
+                break
+            r = edge_row[(min(b, c), max(b, c))]
+            if r == s:  # back at the start
+                closed = cyc.pop() == cyc[0]
+                break
+            if seen[r]:
+                break
+            seen[r] = True
+            rows.append(r)
+            a, b = b, c
+        if not closed:
+            continue
+        found += 1
+        if len(cyc) < 3 or len(cyc) > max_length or len(set(cyc)) != len(cyc):
+            continue
+        loops.append(cyc)
+        loop_owner.append(hole_owner[rows])
+    # no bubble: a cap smaller than half of the piece of surface it closes
+    face_area = np.array([_area(pts, oriented.cycle(i)) for i in range(len(oriented))])
+    _, eid = np.unique(keys, return_inverse=True)
+    nf = len(oriented)
+    g = sparse.csr_matrix(
+        (np.ones(owner.shape[0], dtype=np.int8), (owner, eid + nf)),
+        shape=(nf + int(eid.max()) + 1,) * 2,
+    )
+    _, lab = csgraph.connected_components(g, directed=False)
+    piece_area = np.bincount(lab[:nf], weights=face_area)
+    keep = [
+        i
+        for i, cyc in enumerate(loops)
+        if _area(pts, np.array(cyc)) < 0.5 * piece_area[lab[loop_owner[i][0]]]
+    ]
+    # links kept disks: drop offending loops until none
+    disk_before = face_links(n, oriented)
+    while keep:
+        trial = concat(oriented, _cycleset([loops[i] for i in keep]))
+        disk_after = face_links(n, trial)
+        worse = disk_before & ~disk_after
+        drop = [i for i in keep if worse[loops[i]].any()]
+        if not drop:
+            break
+        keep = [i for i in keep if i not in drop]
+    return HoleLoops(_cycleset([_canonical(loops[i]) for i in keep]), found)
+
+
+def _cycleset(cycles: list[list[int]]) -> CycleSet:
+    lengths = np.array([len(c) for c in cycles], dtype=np.int64)
+    offsets = np.zeros(lengths.shape[0] + 1, dtype=np.int64)
+    np.cumsum(lengths, out=offsets[1:])
+    verts = np.array([v for c in cycles for v in c], dtype=np.int64)
+    return CycleSet(offsets=offsets, vertices=verts)
+
+
+def uncovered(points, triangles, loop_of_triangle, lengths_scale, *, cover: float = 1.0):
+    """Which loop faces have a triangle point farther than ``cover`` x scale from every sample.
+
+    Parameters
+    ----------
+    points : (n, 3) float64
+        The samples.
+    triangles : (t, 3) int64
+        The triangles of the loop faces.
+    loop_of_triangle : (t,) int64
+        The loop (0-based among the loops) of every triangle.
+    lengths_scale : (l,) float64
+        The longest edge of every loop.
+    cover : float
+        The coverage factor of the module docstring.
+
+    Returns
+    -------
+    (l,) bool
+        True for a loop whose triangulation is not covered.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    bad = np.zeros(lengths_scale.shape[0], dtype=bool)
+    if triangles.shape[0] == 0:
+        return bad
+    p = pts[triangles]
+    test = np.concatenate([p.mean(axis=1), 0.5 * (p + np.roll(p, -1, axis=1)).reshape(-1, 3)])
+    who = np.concatenate([loop_of_triangle, np.repeat(loop_of_triangle, 3)])
+    d, _ = cKDTree(pts).query(test)
+    bad[who[d > cover * lengths_scale[who]]] = True
+    return bad
