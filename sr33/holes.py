@@ -267,3 +267,59 @@ def uncovered(points, triangles, loop_of_triangle, lengths_scale, *, cover: floa
     d, _ = cKDTree(pts).query(test)
     bad[who[d > cover * lengths_scale[who]]] = True
     return bad
+
+
+def unpinch(faces: CycleSet, n: int) -> np.ndarray:
+    """Faces to remove so that every sample's link is at most one piece.
+
+    At a sample whose faces' corners form several pieces (a pinched vertex:
+    two fans touching at a point, or a fan plus a stray face), the faces of
+    every piece but the largest (most corners; ties: the piece with the
+    smallest neighbour) are returned.  Removing them opens holes that
+    :func:`hole_loops` can close again, each with a disk round the sample,
+    and leaves their samples to the cones when nothing else uses them.
+
+    Parameters
+    ----------
+    faces : CycleSet
+        The face cycles.
+    n : int
+        Number of samples.
+
+    Returns
+    -------
+    (r,) int64
+        Sorted indices of the faces to remove.
+    """
+    if len(faces) == 0:
+        return np.empty(0, np.int64)
+    v, p, q = _corners(faces)
+    owner = np.repeat(np.arange(len(faces)), faces.lengths)
+    disk = links_are_disks(n, v, p, q)
+    bad = np.flatnonzero(~disk[v])
+    if bad.shape[0] == 0:
+        return np.empty(0, np.int64)
+    order = bad[np.argsort(v[bad], kind="stable")]
+    out: set[int] = set()
+    splits = np.flatnonzero(np.diff(v[order])) + 1
+    for group in np.split(order, splits):
+        piece: dict[int, int] = {}
+
+        def find(x: int, piece=piece) -> int:
+            while piece.setdefault(x, x) != x:
+                x = piece[x]
+            return x
+
+        for k in group.tolist():
+            ra, rb = find(int(p[k])), find(int(q[k]))
+            if ra != rb:
+                piece[max(ra, rb)] = min(ra, rb)
+        roots = [find(int(p[k])) for k in group.tolist()]
+        count: dict[int, int] = {}
+        for r in roots:
+            count[r] = count.get(r, 0) + 1
+        if len(count) < 2:
+            continue  # one piece that is not a path or cycle: left alone
+        keep = min(count, key=lambda r: (-count[r], r))
+        out |= {int(owner[k]) for k, r in zip(group.tolist(), roots) if r != keep}
+    return np.array(sorted(out), dtype=np.int64)

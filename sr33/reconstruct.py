@@ -11,13 +11,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import sparse
+from scipy.sparse import csgraph
 
 from ._validate import as_points, check_k, check_max_cycle_length, check_not_degenerate
 from .backtracking import backtracking
 from .cones import attach_cones, ring_centres
 from .cycles import CycleSet, trivial_isometric_cycles
 from .graph import cycle_edges
-from .holes import HoleLoops, concat, face_links, hole_loops, uncovered
+from .holes import HoleLoops, concat, face_links, hole_loops, uncovered, unpinch
 from .mesh import edge_keys, self_intersections
 from .progress import log, timed
 from .rng import localized_rng
@@ -132,9 +134,12 @@ def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolera
     that crosses another triangle (a bevelled acute edge's sample under a
     quad) gives its sample back to the cones, which insert it where nothing
     crosses.  Returns the faces, their triangulation, the centres used and
-    the number of loop faces kept.
+    the number of loop faces kept, and the *flaps*: faces of ``base`` that a
+    dropped loop face crossed and that have two or more samples on that
+    loop (a face folded over the hole).
     """
     nb = len(base)
+    flaps: set[int] = set()
     loops = holes.loops if holes is not None else None
     active = list(range(len(loops))) if loops is not None else []
     no_centre: set[tuple[str, int]] = set()
@@ -148,6 +153,12 @@ def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolera
         hits = self_intersections(pts, tr.triangles)
         crossing = set(fot[hits.ravel()].tolist())
         drop = {f for f in crossing if f >= nb}
+        for a, b in fot[hits].tolist():
+            for lf, bf in ((a, b), (b, a)):
+                if lf >= nb > bf:
+                    ring = set(faces.cycle(lf).tolist())
+                    if len(ring & set(faces.cycle(bf).tolist())) >= 2:
+                        flaps.add(bf)
         if active:
             is_loop = fot >= nb
             sub = faces.subset(np.arange(nb, len(faces)))
@@ -171,7 +182,59 @@ def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolera
         if not bad_centres or rounds > 3:
             break
         no_centre |= {key[f] for f in bad_centres}
-    return faces, tr, centres, len(active)
+    return faces, tr, centres, len(active), flaps
+
+
+def _piece_of_face(faces: CycleSet, n: int) -> np.ndarray:
+    """For every face cycle, its connected piece of the surface (labels 0..)."""
+    pairs, owner = cycle_edges(faces.offsets, faces.vertices)
+    g = sparse.csr_matrix((np.ones(pairs.shape[0], np.int8), (pairs[:, 0], pairs[:, 1])), (n, n))
+    _, lab = csgraph.connected_components(g, directed=False)
+    first = lab[faces.vertices[faces.offsets[:-1]]]
+    return np.unique(first, return_inverse=True)[1].reshape(-1)
+
+
+def _close_holes(pts, base: CycleSet, max_hole_length: int, tolerance: Tolerance, grow: int = 3):
+    """The selection with its boundary loops closed (:mod:`sr33.holes`).
+
+    Where a loop face crossed faces folded over its hole (flaps), or where
+    a sample's faces form several pieces (:func:`sr33.holes.unpinch`), those
+    faces are removed and the larger hole's loop is tried instead, up to
+    ``grow`` times; pieces of the surface that removing flaps detaches are removed
+    too (their samples go to the cones); the round with the fewest open
+    edges plus pinched samples (then the first) is kept.
+    Returns the faces, their triangulation, the centres and the number of
+    loop faces.
+    """
+    best, best_open = None, None
+    cur = base
+    pieces = int(_piece_of_face(base, pts.shape[0]).max()) + 1 if len(base) else 0
+    for _ in range(grow + 1):
+        holes = hole_loops(pts, cur, max_length=max_hole_length) if max_hole_length else None
+        faces, tr, centres, n_loops, flaps = _triangulate_with_loops(pts, cur, holes, tolerance)
+        used = np.zeros(pts.shape[0], dtype=bool)
+        used[faces.vertices] = True
+        pinched = int((used & ~face_links(pts.shape[0], faces)).sum()) if len(faces) else 0
+        n_open = _edge_use(faces, pts.shape[0])[0].shape[0] + pinched
+        if best_open is None or n_open < best_open:
+            best, best_open = (faces, tr, centres, n_loops), n_open
+        # the loops' base faces come first in ``faces``: unpinch on the base
+        flaps |= set(unpinch(cur, pts.shape[0]).tolist())
+        if not flaps or not max_hole_length:
+            break
+        log.debug("hole loops: %d flaps and pinching faces removed", len(flaps))
+        keep = np.ones(len(cur), dtype=bool)
+        keep[sorted(flaps)] = False
+        cur = cur.subset(keep)
+        # pieces the flaps held on are detached bits: their samples go to the cones
+        if len(cur):
+            lab = _piece_of_face(cur, pts.shape[0])
+            size = np.bincount(lab)
+            extra = size.shape[0] - pieces
+            if extra > 0:
+                small = np.lexsort((np.arange(size.shape[0]), size))[:extra]
+                cur = cur.subset(~np.isin(lab, small))
+    return best
 
 
 def reconstruct(
@@ -258,10 +321,8 @@ def reconstruct(
             exact_seconds=exact_seconds,
             quiet=quiet,
         )
-    with timed("hole_loops", timings):
-        holes = hole_loops(pts, sel.faces, max_length=max_hole_length) if max_hole_length else None
     with timed("triangulate", timings):
-        faces, tr, centres, n_loops = _triangulate_with_loops(pts, sel.faces, holes, tolerance)
+        faces, tr, centres, n_loops = _close_holes(pts, sel.faces, max_hole_length, tolerance)
         tri = tr.triangles
     if strict_default() if strict is None else strict:
         with timed("self_checks", timings):

@@ -4,7 +4,7 @@ import numpy as np
 
 from sr33 import reconstruct
 from sr33.cycles import CycleSet
-from sr33.holes import concat, face_links, hole_loops, uncovered
+from sr33.holes import concat, face_links, hole_loops, uncovered, unpinch
 from sr33.io import read_points
 from sr33.samplers import cube_lattice
 from sr33.triangulate import triangulate
@@ -123,3 +123,20 @@ def test_a_figure_eight_boundary_splits_into_the_two_loops_that_unpinch_it():
     assert sorted(map(sorted, hl.loops.as_tuples())) == sorted(sorted(g) for g in gone)
     disk = face_links(pts.shape[0], concat(faces, hl.loops))
     assert disk.all()
+
+
+def test_unpinch_removes_the_smaller_fan_at_a_pinched_sample():
+    # a 4 x 4 grid and a 1 x 2 strip standing on its centre sample 12
+    pts, quads = _grid(4)
+    extra = np.array([[3.0, 2.0, 1.0], [3.0, 2.0, 2.0], [2.0, 2.0, 2.0], [3.0, 2.0, 3.0]])
+    pts = np.vstack([pts, extra, [[2.0, 2.0, 3.0]]])
+    strip = [[12, 25, 26, 27], [27, 26, 28, 29]]
+    faces = _cycles(quads + strip)
+    assert not face_links(pts.shape[0], faces)[12]
+    gone = unpinch(faces, pts.shape[0])
+    assert gone.tolist() == [len(quads)]  # the strip's face at 12, nothing else
+    keep = np.ones(len(faces), bool)
+    keep[gone] = False
+    assert face_links(pts.shape[0], faces.subset(keep))[12]
+    # a sample whose link is already a disk is never touched
+    assert unpinch(_cycles(quads), pts.shape[0]).shape[0] == 0
