@@ -200,8 +200,16 @@ def hole_loops(points, faces: CycleSet, *, max_length: int = 66) -> HoleLoops:
             continue
         loops.append(cyc)
         loop_owner.append(hole_owner[rows])
+    found_loops = HoleLoops(CycleSet(np.zeros(1, np.int64), np.empty(0, np.int64)), found)
+    if not loops:
+        return found_loops
     # no bubble: a cap smaller than half of the piece of surface it closes
-    face_area = np.array([_area(pts, oriented.cycle(i)) for i in range(len(oriented))])
+    first = np.repeat(faces.vertices[faces.offsets[:-1]], faces.lengths)
+    nxt_v = pairs[:, 1]
+    fan = 0.5 * np.linalg.norm(
+        np.cross(pts[faces.vertices] - pts[first], pts[nxt_v] - pts[first]), axis=1
+    )
+    face_area = np.bincount(owner, weights=fan, minlength=len(faces))
     _, eid = np.unique(keys, return_inverse=True)
     nf = len(oriented)
     g = sparse.csr_matrix(

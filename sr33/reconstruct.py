@@ -150,7 +150,10 @@ def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolera
         centres = {f: c for f, c in ring_centres(pts, faces).items() if key[f] not in no_centre}
         tr = triangulate(pts, faces, rtol=tolerance.rtol, centres=centres)
         fot = tr.face_of_triangle
-        hits = self_intersections(pts, tr.triangles)
+        if centres or active:
+            hits = self_intersections(pts, tr.triangles)
+        else:  # nothing optional to give up: the crossings are not looked for
+            hits = np.empty((0, 2), dtype=np.int64)
         crossing = set(fot[hits.ravel()].tolist())
         drop = {f for f in crossing if f >= nb}
         for a, b in fot[hits].tolist():
