@@ -197,7 +197,7 @@ def _piece_of_face(faces: CycleSet, n: int) -> np.ndarray:
     return np.unique(first, return_inverse=True)[1].reshape(-1)
 
 
-def _close_holes(pts, base: CycleSet, max_hole_length: int, tolerance: Tolerance, grow: int = 3):
+def _close_holes(pts, base: CycleSet, max_hole_length: int, tolerance: Tolerance, grow: int = 6):
     """The selection with its boundary loops closed (:mod:`sr33.holes`).
 
     Where a loop face crossed faces folded over its hole (flaps), or where
