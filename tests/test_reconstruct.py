@@ -1,5 +1,7 @@
 """reconstruct (Algorithm 1): invariance, determinism, small paper sets."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -110,3 +112,28 @@ def test_strict_self_check_catches_a_broken_triangulation():
     two = CycleSet(np.array([0, 3, 6, 9]), np.array([0, 1, 2, 0, 1, 3, 0, 1, 4]))
     with _pytest.raises(InternalError, match="an edge is used 3 times"):
         check_faces_and_triangles(two, np.array([[0, 1, 2], [0, 1, 3], [0, 1, 4]]), np.arange(3))
+
+
+def test_output_bytes_do_not_depend_on_thread_counts():
+    # numba, OpenMP and BLAS thread pools of 1 and 2 threads: the same bytes
+    import subprocess
+    import sys
+
+    code = (
+        "import hashlib, numpy as np\n"
+        "from sr33 import reconstruct\n"
+        "from sr33.samplers import cube_lattice\n"
+        "p = cube_lattice(8) + 0.01 * np.sin(np.arange(3 * 386)).reshape(-1, 3)\n"
+        "r = reconstruct(p, 12)\n"
+        "print(hashlib.sha256(r.triangles.tobytes()).hexdigest(), r.triangles.shape[0])\n"
+    )
+    out = []
+    for threads in ("1", "2"):
+        env = dict(os.environ)
+        for pool in ("NUMBA", "OMP", "OPENBLAS", "MKL"):
+            env[f"{pool}_NUM_THREADS"] = threads
+        res = subprocess.run(
+            [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+        )
+        out.append(res.stdout.split())
+    assert out[0] == out[1] and int(out[0][1]) > 0
