@@ -9,10 +9,10 @@ does that for the loops the selection leaves open.
 
 A loop becomes a face only when all of these hold:
 
-* it is a simple cycle of open edges (each sample once), read off the
-  oriented faces: at a sample where the boundary passes more than once, an
-  incoming boundary edge continues with an outgoing one from another piece
-  of the sample's link (so that filling every loop there closes the link);
+* it is a simple cycle of open edges (each sample once): at a sample where
+  the boundary passes more than once, a loop arriving along one open edge
+  leaves along one that ends another piece of the sample's link (so that
+  filling every loop there closes the link);
 * it has at most ``max_length`` edges (the minimum-area triangulation is
   O(L³));
 * adding it leaves the link of every sample that was a disk a disk;
@@ -121,7 +121,6 @@ def hole_loops(points, faces: CycleSet, *, max_length: int = 66) -> HoleLoops:
     empty = HoleLoops(CycleSet(np.zeros(1, np.int64), np.empty(0, np.int64)), 0)
     if len(faces) == 0:
         return empty
-    oriented = faces
     pairs, owner = cycle_edges(faces.offsets, faces.vertices)
     keys = edge_keys(pairs[:, 0], pairs[:, 1], n)
     _, inv, cnt = np.unique(keys, return_inverse=True, return_counts=True)
@@ -200,9 +199,8 @@ def hole_loops(points, faces: CycleSet, *, max_length: int = 66) -> HoleLoops:
             continue
         loops.append(cyc)
         loop_owner.append(hole_owner[rows])
-    found_loops = HoleLoops(CycleSet(np.zeros(1, np.int64), np.empty(0, np.int64)), found)
     if not loops:
-        return found_loops
+        return HoleLoops(empty.loops, found)
     # no bubble: a cap smaller than half of the piece of surface it closes
     first = np.repeat(faces.vertices[faces.offsets[:-1]], faces.lengths)
     nxt_v = pairs[:, 1]
@@ -211,7 +209,7 @@ def hole_loops(points, faces: CycleSet, *, max_length: int = 66) -> HoleLoops:
     )
     face_area = np.bincount(owner, weights=fan, minlength=len(faces))
     _, eid = np.unique(keys, return_inverse=True)
-    nf = len(oriented)
+    nf = len(faces)
     g = sparse.csr_matrix(
         (np.ones(owner.shape[0], dtype=np.int8), (owner, eid + nf)),
         shape=(nf + int(eid.max()) + 1,) * 2,
@@ -224,9 +222,9 @@ def hole_loops(points, faces: CycleSet, *, max_length: int = 66) -> HoleLoops:
         if _area(pts, np.array(cyc)) < 0.5 * piece_area[lab[loop_owner[i][0]]]
     ]
     # links kept disks: drop offending loops until none
-    disk_before = face_links(n, oriented)
+    disk_before = face_links(n, faces)
     while keep:
-        trial = concat(oriented, _cycleset([loops[i] for i in keep]))
+        trial = concat(faces, _cycleset([loops[i] for i in keep]))
         disk_after = face_links(n, trial)
         worse = disk_before & ~disk_after
         drop = [i for i in keep if worse[loops[i]].any()]
