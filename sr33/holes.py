@@ -77,6 +77,23 @@ def _corners(faces: CycleSet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return faces.vertices, faces.vertices[prev], pairs[:, 1]
 
 
+def _link_pieces(prev, nxt) -> dict[int, int]:
+    """Neighbour -> piece of a sample's link (the smallest neighbour of the
+    piece), for corners ``(prev[i], nxt[i])`` at that sample."""
+    parent: dict[int, int] = {}
+
+    def find(x: int) -> int:
+        while parent.setdefault(x, x) != x:
+            x = parent[x]
+        return x
+
+    for a, b in zip(prev, nxt):
+        ra, rb = find(int(a)), find(int(b))
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)
+    return {x: find(x) for x in list(parent)}
+
+
 def concat(a: CycleSet, b: CycleSet) -> CycleSet:
     """The cycles of ``a`` followed by those of ``b``."""
     return CycleSet(
@@ -91,10 +108,14 @@ def face_links(n: int, faces: CycleSet) -> np.ndarray:
     return links_are_disks(n, v, p, q)
 
 
-def _area(points, cyc) -> float:
-    """Area of a fan triangulation of a cycle (a cheap size estimate)."""
-    p = points[cyc]
-    return float(0.5 * np.linalg.norm(np.cross(p[1:-1] - p[0], p[2:] - p[0]), axis=1).sum())
+def _fan_areas(points, cs: CycleSet) -> np.ndarray:
+    """Area of a fan triangulation of every cycle (a cheap size estimate)."""
+    pairs, owner = cycle_edges(cs.offsets, cs.vertices)
+    first = points[np.repeat(cs.vertices[cs.offsets[:-1]], cs.lengths)]
+    fan = 0.5 * np.linalg.norm(
+        np.cross(points[pairs[:, 0]] - first, points[pairs[:, 1]] - first), axis=1
+    )
+    return np.bincount(owner, weights=fan, minlength=len(cs))
 
 
 def hole_loops(points, faces: CycleSet, *, max_length: int = 66) -> HoleLoops:
@@ -150,19 +171,12 @@ def hole_loops(points, faces: CycleSet, *, max_length: int = 66) -> HoleLoops:
             continue
         # pieces of v's link: neighbours joined by corners at v; a loop
         # passing v joins the ends of two different pieces
-        piece: dict[int, int] = {}
-
-        def find(x: int, piece=piece) -> int:
-            while piece.setdefault(x, x) != x:
-                x = piece[x]
-            return x
-
-        for k in corner_order[starts[v] : starts[v + 1]].tolist():
-            piece[find(int(p_all[k]))] = find(int(q_all[k]))
+        ks = corner_order[starts[v] : starts[v + 1]]
+        piece = _link_pieces(p_all[ks], q_all[ks])
         free = list(nbrs)
         while free:
             x = free.pop(0)
-            other = [y for y in free if find(y) != find(x)]
+            other = [y for y in free if piece[y] != piece[x]]
             y = (other or free)[0]
             free.remove(y)
             partner[(v, x)], partner[(v, y)] = y, x
@@ -202,12 +216,8 @@ def hole_loops(points, faces: CycleSet, *, max_length: int = 66) -> HoleLoops:
     if not loops:
         return HoleLoops(empty.loops, found)
     # no bubble: a cap smaller than half of the piece of surface it closes
-    first = np.repeat(faces.vertices[faces.offsets[:-1]], faces.lengths)
-    nxt_v = pairs[:, 1]
-    fan = 0.5 * np.linalg.norm(
-        np.cross(pts[faces.vertices] - pts[first], pts[nxt_v] - pts[first]), axis=1
-    )
-    face_area = np.bincount(owner, weights=fan, minlength=len(faces))
+    face_area = _fan_areas(pts, faces)
+    cap_area = _fan_areas(pts, _cycleset(loops))
     _, eid = np.unique(keys, return_inverse=True)
     nf = len(faces)
     g = sparse.csr_matrix(
@@ -216,11 +226,7 @@ def hole_loops(points, faces: CycleSet, *, max_length: int = 66) -> HoleLoops:
     )
     _, lab = csgraph.connected_components(g, directed=False)
     piece_area = np.bincount(lab[:nf], weights=face_area)
-    keep = [
-        i
-        for i, cyc in enumerate(loops)
-        if _area(pts, np.array(cyc)) < 0.5 * piece_area[lab[loop_owner[i][0]]]
-    ]
+    keep = [i for i in range(len(loops)) if cap_area[i] < 0.5 * piece_area[lab[loop_owner[i][0]]]]
     # links kept disks: drop offending loops until none
     disk_before = face_links(n, faces)
     while keep:
@@ -309,18 +315,8 @@ def unpinch(faces: CycleSet, n: int) -> np.ndarray:
     out: set[int] = set()
     splits = np.flatnonzero(np.diff(v[order])) + 1
     for group in np.split(order, splits):
-        piece: dict[int, int] = {}
-
-        def find(x: int, piece=piece) -> int:
-            while piece.setdefault(x, x) != x:
-                x = piece[x]
-            return x
-
-        for k in group.tolist():
-            ra, rb = find(int(p[k])), find(int(q[k]))
-            if ra != rb:
-                piece[max(ra, rb)] = min(ra, rb)
-        roots = [find(int(p[k])) for k in group.tolist()]
+        piece = _link_pieces(p[group], q[group])
+        roots = [piece[int(p[k])] for k in group.tolist()]
         count: dict[int, int] = {}
         for r in roots:
             count[r] = count.get(r, 0) + 1

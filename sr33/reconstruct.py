@@ -115,15 +115,31 @@ def _canonical_order(uniq, first, inverse):
     return uniq[order], first[order], back[inverse]
 
 
-def _edge_use(faces: CycleSet, n: int) -> tuple[np.ndarray, int]:
-    """Edges used by one face cycle (rows (a, b), a < b, sorted) and the
-    number of edges used more than twice."""
+@dataclass(frozen=True)
+class _Figures:
+    """What the success condition reads off a set of face cycles."""
+
+    open_edges: np.ndarray  # (p, 2) edges used by one face, a < b, sorted
+    overloaded: int  # edges used by three or more faces
+    disk: np.ndarray  # (n,) bool, the sample's link is a disk
+    used: np.ndarray  # (n,) bool, some face uses the sample
+
+    @property
+    def defects(self) -> int:
+        """Open edges plus used samples whose link is not a disk."""
+        return self.open_edges.shape[0] + int((self.used & ~self.disk).sum())
+
+
+def _figures(faces: CycleSet, n: int) -> _Figures:
+    used = np.zeros(n, dtype=bool)
     if len(faces) == 0:
-        return np.empty((0, 2), np.int64), 0
+        return _Figures(np.empty((0, 2), np.int64), 0, np.zeros(n, dtype=bool), used)
+    used[faces.vertices] = True
     pairs, _ = cycle_edges(faces.offsets, faces.vertices)
     keys, cnt = np.unique(edge_keys(pairs[:, 0], pairs[:, 1], n), return_counts=True)
     once = keys[cnt == 1]
-    return np.stack([once // n, once % n], axis=1).astype(np.int64), int((cnt > 2).sum())
+    open_edges = np.stack([once // n, once % n], axis=1).astype(np.int64)
+    return _Figures(open_edges, int((cnt > 2).sum()), face_links(n, faces), used)
 
 
 def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolerance: Tolerance):
@@ -165,9 +181,8 @@ def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolera
         if active:
             is_loop = fot >= nb
             sub = faces.subset(np.arange(nb, len(faces)))
-            ends = np.roll(np.arange(sub.vertices.shape[0]), -1)
-            ends[sub.offsets[1:] - 1] = sub.offsets[:-1]
-            el = np.linalg.norm(pts[sub.vertices] - pts[sub.vertices[ends]], axis=1)
+            pairs, _ = cycle_edges(sub.offsets, sub.vertices)
+            el = np.linalg.norm(pts[pairs[:, 0]] - pts[pairs[:, 1]], axis=1)
             scale = np.maximum.reduceat(el, sub.offsets[:-1])
             bad = uncovered(pts, tr.triangles[is_loop], fot[is_loop] - nb, scale)
             drop |= {nb + int(i) for i in np.flatnonzero(bad)}
@@ -206,21 +221,18 @@ def _close_holes(pts, base: CycleSet, max_hole_length: int, tolerance: Tolerance
     ``grow`` times; pieces of the surface that removing flaps detaches are removed
     too (their samples go to the cones); the round with the fewest open
     edges plus pinched samples (then the first) is kept.
-    Returns the faces, their triangulation, the centres and the number of
-    loop faces.
+    Returns the faces, their triangulation, the centres, the number of
+    loop faces and the faces' figures.
     """
-    best, best_open = None, None
+    best = None
     cur = base
     pieces = int(_piece_of_face(base, pts.shape[0]).max()) + 1 if len(base) else 0
     for _ in range(grow + 1):
         holes = hole_loops(pts, cur, max_length=max_hole_length) if max_hole_length else None
         faces, tr, centres, n_loops, flaps = _triangulate_with_loops(pts, cur, holes, tolerance)
-        used = np.zeros(pts.shape[0], dtype=bool)
-        used[faces.vertices] = True
-        pinched = int((used & ~face_links(pts.shape[0], faces)).sum()) if len(faces) else 0
-        n_open = _edge_use(faces, pts.shape[0])[0].shape[0] + pinched
-        if best_open is None or n_open < best_open:
-            best, best_open = (faces, tr, centres, n_loops), n_open
+        figs = _figures(faces, pts.shape[0])
+        if best is None or figs.defects < best[-1].defects:
+            best = (faces, tr, centres, n_loops, figs)
         # the loops' base faces come first in ``faces``: unpinch on the base
         flaps |= set(unpinch(cur, pts.shape[0]).tolist())
         if not flaps or not max_hole_length:
@@ -325,7 +337,7 @@ def reconstruct(
             quiet=quiet,
         )
     with timed("triangulate", timings):
-        faces, tr, centres, n_loops = _close_holes(pts, sel.faces, max_hole_length, tolerance)
+        faces, tr, centres, n_loops, figs = _close_holes(pts, sel.faces, max_hole_length, tolerance)
         tri = tr.triangles
     if strict_default() if strict is None else strict:
         with timed("self_checks", timings):
@@ -342,17 +354,14 @@ def reconstruct(
     rng_edges = np.sort(relabel[rng.edges], axis=1)
     rng_edges = rng_edges[np.lexsort((rng_edges[:, 1], rng_edges[:, 0]))]
     # the success condition and its figures on the final faces (loops included)
-    still_open, over = _edge_use(faces, pts.shape[0])
+    still_open, disk = figs.open_edges, figs.disk
     was_open = edge_keys(sel.open_edges[:, 0], sel.open_edges[:, 1], pts.shape[0])
     now_open = edge_keys(still_open[:, 0], still_open[:, 1], pts.shape[0])
     bad_open = was_open[~sel.true_boundary]
-    disk = face_links(pts.shape[0], faces) if len(faces) else np.zeros(pts.shape[0], bool)
-    used = np.zeros(pts.shape[0], dtype=bool)
-    used[faces.vertices] = True
     success = bool(
         len(faces) > 0
-        and over == 0
-        and not np.any(used & ~disk)
+        and figs.overloaded == 0
+        and not np.any(figs.used & ~disk)
         and not np.isin(now_open, bad_open).any()
     )
     open_edges = np.sort(relabel[still_open], axis=1) if still_open.size else still_open
