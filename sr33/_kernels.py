@@ -323,3 +323,129 @@ def neighbourhood_disks(
         comps[u] = ncomp
         nfaces[u] = ni
     return chi, comps, nfaces
+
+
+@njit(cache=True)
+def _tri_area(p, a, b, c):
+    ux = p[b, 0] - p[a, 0]
+    uy = p[b, 1] - p[a, 1]
+    uz = p[b, 2] - p[a, 2]
+    vx = p[c, 0] - p[a, 0]
+    vy = p[c, 1] - p[a, 1]
+    vz = p[c, 2] - p[a, 2]
+    cx = uy * vz - uz * vy
+    cy = uz * vx - ux * vz
+    cz = ux * vy - uy * vx
+    return 0.5 * np.sqrt(cx * cx + cy * cy + cz * cz)
+
+
+@njit(cache=True)
+def _cmp_tol(x, y, rtol):
+    if abs(x - y) <= rtol * max(abs(x), abs(y)):
+        return 0
+    return -1 if x < y else 1
+
+
+@njit(cache=True)
+def min_area_splits(p, allowed, rtol):
+    """Dynamic programme of the minimum-area triangulation of a polygon.
+
+    ``p`` (L, 3) are the polygon's corners in order, ``allowed[i, j]``
+    whether the chord i-j may be used (sides always may).  Splits are
+    compared by total area, ties (relative ``rtol``) by total chord length,
+    then the earlier split wins.  Returns ``(split, feasible)``:
+    ``split[i, j]`` is the apex m of the triangle on chord (i, j), -1 where
+    no triangulation of that sub-polygon exists.
+    """
+    L = p.shape[0]
+    inf = np.inf
+    cost = np.zeros((L, L))
+    tie = np.zeros((L, L))
+    split = -np.ones((L, L), dtype=np.int64)
+    for span in range(2, L):
+        for i in range(0, L - span):
+            j = i + span
+            if not allowed[i, j] and not (i == 0 and j == L - 1):
+                cost[i, j] = inf
+                continue
+            best_c = inf
+            best_t = inf
+            for m in range(i + 1, j):
+                if cost[i, m] == inf or cost[m, j] == inf:
+                    continue
+                c = cost[i, m] + cost[m, j] + _tri_area(p, i, m, j)
+                diag = tie[i, m] + tie[m, j]
+                if m - i > 1:
+                    diag += np.sqrt(_sqdist(p, i, m))
+                if j - m > 1:
+                    diag += np.sqrt(_sqdist(p, m, j))
+                cmp = _cmp_tol(c, best_c, rtol) if best_c < inf else -1
+                if cmp == 0:
+                    cmp = _cmp_tol(diag, best_t, rtol)
+                if cmp < 0:
+                    best_c = c
+                    best_t = diag
+                    cost[i, j] = c
+                    tie[i, j] = diag
+                    split[i, j] = m
+            if best_c == inf:
+                cost[i, j] = inf
+    return split, cost[0, L - 1] < inf
+
+
+@njit(cache=True)
+def _unit_normal(p, a, b, c, out):
+    ux = p[b, 0] - p[a, 0]
+    uy = p[b, 1] - p[a, 1]
+    uz = p[b, 2] - p[a, 2]
+    vx = p[c, 0] - p[a, 0]
+    vy = p[c, 1] - p[a, 1]
+    vz = p[c, 2] - p[a, 2]
+    out[0] = uy * vz - uz * vy
+    out[1] = uz * vx - ux * vz
+    out[2] = ux * vy - uy * vx
+    length = np.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2])
+    if length > 0:
+        out[0] /= length
+        out[1] /= length
+        out[2] /= length
+    return length > 0
+
+
+@njit(cache=True)
+def _turn(p, t1, t2, n1, n2):
+    """Angle between the normals of triangles t1 and t2 (pi if one is flat)."""
+    if not _unit_normal(p, t1[0], t1[1], t1[2], n1) or not _unit_normal(p, t2[0], t2[1], t2[2], n2):
+        return np.pi
+    d = n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2]
+    return np.arccos(min(1.0, max(-1.0, d)))
+
+
+@njit(cache=True)
+def flip_costs(p, t1, t2, quad, across):
+    """Curvature cost of an edge flip's five edges, before and after.
+
+    ``quad`` = (p, q, r, s): triangles ``t1`` = (p, q, r) and ``t2`` =
+    (q, p, s) (up to rotation) share the edge (p, q), which the flip
+    replaces by (r, s) with triangles (r, p, s) and (s, q, r); ``across``
+    (4, 3) are the triangles on the other sides of (q, r), (r, p), (p, s),
+    (s, q).  An edge costs its length times the angle between its
+    triangles' normals.  Returns ``(before, after, largest angle after)``.
+    """
+    n1 = np.empty(3)
+    n2 = np.empty(3)
+    a, b, r, s = quad[0], quad[1], quad[2], quad[3]
+    outer = np.array([[b, r], [r, a], [a, s], [s, b]])
+    new1 = np.array([r, a, s])
+    new2 = np.array([s, b, r])
+    before = np.sqrt(_sqdist(p, a, b)) * _turn(p, t1, t2, n1, n2)
+    tt = _turn(p, new1, new2, n1, n2)
+    after = np.sqrt(_sqdist(p, r, s)) * tt
+    largest = tt
+    for k in range(4):
+        length = np.sqrt(_sqdist(p, outer[k, 0], outer[k, 1]))
+        before += length * _turn(p, t1 if k < 2 else t2, across[k], n1, n2)
+        tt = _turn(p, new2 if k == 0 or k == 3 else new1, across[k], n1, n2)
+        largest = max(largest, tt)
+        after += length * tt
+    return before, after, largest

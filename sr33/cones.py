@@ -24,9 +24,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ._kernels import flip_costs
 from ._validate import InputError, as_points
 from .mesh import (
     closest_points_on_triangles,
+    cross,
     dot,
     half_edges,
     norm,
@@ -186,7 +188,7 @@ def attach_cones(
 def _flat(pts, triangles) -> bool:
     """Whether a triangle has (numerically) no area: its sample on an edge's line."""
     t = pts[np.asarray(triangles, dtype=np.int64)]
-    cr = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    cr = cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
     longest = max(float(norm(t[:, 1] - t[:, 0]).max()), float(norm(t[:, 2] - t[:, 0]).max()))
     return bool(np.any(norm(cr) <= 1e-9 * longest * longest))
 
@@ -225,20 +227,6 @@ def _insertions(pts, p: int, cand: list[int], tris, owner) -> list:
             out.append((dd, 1, i, [i, j], [(u, p, third), (p, v, third), (v, p, w), (p, u, w)]))
     out.sort(key=lambda r: (r[0], r[1], r[2]))
     return [(r[0], r[3], r[4]) for r in out]
-
-
-def _normal(points, tri) -> np.ndarray:
-    n = np.cross(points[tri[1]] - points[tri[0]], points[tri[2]] - points[tri[0]])
-    length = float(norm(n))
-    return n / length if length > 0 else n
-
-
-def _turn(points, t1, t2) -> float:
-    """Angle between the normals of two triangles (0: flat, pi: folded back)."""
-    n1, n2 = _normal(points, t1), _normal(points, t2)
-    if not n1.any() or not n2.any():
-        return np.pi
-    return float(np.arccos(np.clip(float(dot(n1, n2)), -1.0, 1.0)))
 
 
 def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
@@ -290,9 +278,6 @@ def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
     near[np.unique(keys[counts != 2])] = False
     limit = np.radians(165.0)
 
-    def cost(a, b, t_ab, t_ba) -> float:
-        return float(norm(pts[a] - pts[b])) * _turn(pts, t_ab, t_ba)
-
     def across(a, b):
         k = owner.get((b, a))
         return None if k is None else tri[k]
@@ -317,17 +302,10 @@ def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
             t1, t2 = tri[i], tri[j]
             new1 = np.array([r, p, s_])
             new2 = np.array([s_, q, r])
-            before = cost(p, q, t1, t2) + sum(
-                cost(a, b, t1 if k < 2 else t2, nb[k]) for k, (a, b) in enumerate(outer)
+            before, after, largest = flip_costs(
+                pts, t1, t2, np.array([p, q, r, s_], dtype=np.int64), np.array(nb, dtype=np.int64)
             )
-            turns = [_turn(pts, new1, new2)]
-            after = float(norm(pts[r] - pts[s_])) * turns[0]
-            for k, (a, b) in enumerate(outer):
-                own = new2 if k in (0, 3) else new1
-                tt = _turn(pts, own, nb[k])
-                turns.append(tt)
-                after += float(norm(pts[a] - pts[b])) * tt
-            if after >= (1 - 1e-9) * before or max(turns) > limit:
+            if after >= (1 - 1e-9) * before or largest > limit:
                 continue
             new = np.stack([new1, new2])
             mid = pts[new].mean(axis=(0, 1))

@@ -56,6 +56,16 @@ def norm(v) -> np.ndarray:
     return np.sqrt(dot(v, v))
 
 
+def cross(a, b) -> np.ndarray:
+    """Cross products of 3-vectors along the last axis (``np.cross`` without
+    its axis handling, which dominates on small arrays; the same bits)."""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    ax, ay, az = a[..., 0], a[..., 1], a[..., 2]
+    bx, by, bz = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], axis=-1)
+
+
 def edge_keys(a, b, n: int) -> np.ndarray:
     """Order-free int64 key ``min * n + max`` of the undirected edges (a, b)."""
     a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
@@ -357,13 +367,13 @@ def _segments_cross_triangles(p0, p1, a, b, c, eps):
     """Vectorized: does the open segment p0-p1 cross the triangle abc (interior or edge)?"""
     d = p1 - p0
     e1, e2 = b - a, c - a
-    h = np.cross(d, e2)
+    h = cross(d, e2)
     det = np.einsum("ij,ij->i", e1, h)
     ok = np.abs(det) > eps
     inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
     s = p0 - a
     u = inv * np.einsum("ij,ij->i", s, h)
-    q = np.cross(s, e1)
+    q = cross(s, e1)
     v = inv * np.einsum("ij,ij->i", d, q)
     t = inv * np.einsum("ij,ij->i", e2, q)
     tol = 1e-12
@@ -383,6 +393,12 @@ def _candidate_pairs(lo: np.ndarray, hi: np.ndarray, keep=None) -> np.ndarray:
     filters the pairs before deduplication; each pair is reported once.
     """
     n = lo.shape[0]
+    if n <= 192:  # a patch: every pair, no tree
+        a, b = np.triu_indices(n, 1)
+        ok = np.all((lo[a] <= hi[b]) & (lo[b] <= hi[a]), axis=1)
+        if keep is not None:
+            ok &= keep(a, b)
+        return np.stack([a[ok], b[ok]], axis=1).astype(np.int64)
     centre = 0.5 * lo + 0.5 * hi  # no overflow at 1e308
     radius = (0.5 * hi - 0.5 * lo).max(axis=1)
     typical = float(np.median(radius))
@@ -490,8 +506,8 @@ def self_intersections(vertices, triangles, keep=None) -> np.ndarray:
         ob = b[~in_a]
         common = a[in_b].reshape(-1, 2)
         e0, e1 = v[common[:, 0]], v[common[:, 1]]
-        na = np.cross(e1 - e0, v[oa] - e0)
-        nb = np.cross(e1 - e0, v[ob] - e0)
+        na = cross(e1 - e0, v[oa] - e0)
+        nb = cross(e1 - e0, v[ob] - e0)
         la, lb = np.linalg.norm(na, axis=1), np.linalg.norm(nb, axis=1)
         cos = np.einsum("ij,ij->i", na, nb) / np.maximum(la * lb, 1e-300)
         hit[two[cos > 1 - 1e-12]] = True

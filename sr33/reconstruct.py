@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
+from scipy.spatial import cKDTree
 
 from ._validate import as_points, check_k, check_max_cycle_length, check_not_degenerate
 from .backtracking import backtracking
@@ -142,6 +143,28 @@ def _figures(faces: CycleSet, n: int) -> _Figures:
     return _Figures(open_edges, int((cnt > 2).sum()), face_links(n, faces), used)
 
 
+def _optional_crossings(pts, tri: np.ndarray, optional: np.ndarray) -> np.ndarray:
+    """Crossing pairs of triangles with at least one ``optional`` triangle
+    (of a loop face or a ring-centre fan), as rows of triangle indices.
+
+    Only triangles that can reach an optional one are tested: two triangles
+    whose boxes overlap have centroids within the sum of their radii (the
+    farthest corner from the centroid), so the candidates are found with a
+    k-d tree round the optional triangles' centroids.
+    """
+    opt = np.flatnonzero(optional)
+    if opt.shape[0] == 0:
+        return np.empty((0, 2), dtype=np.int64)
+    corners = pts[tri]
+    cen = corners.mean(axis=1)
+    rad = np.linalg.norm(corners - cen[:, None], axis=2).max(axis=1)
+    near = cKDTree(cen).query_ball_point(cen[opt], rad[opt] + rad.max())
+    sub = np.unique(np.concatenate([np.asarray(h, dtype=np.int64) for h in near] + [opt]))
+    mine = optional[sub]
+    hits = self_intersections(pts, tri[sub], keep=lambda a, b: mine[a] | mine[b])
+    return sub[hits]
+
+
 def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolerance: Tolerance):
     """Triangulate the selection plus the boundary loops that stay valid.
 
@@ -166,10 +189,7 @@ def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolera
         centres = {f: c for f, c in ring_centres(pts, faces).items() if key[f] not in no_centre}
         tr = triangulate(pts, faces, rtol=tolerance.rtol, centres=centres)
         fot = tr.face_of_triangle
-        if centres or active:
-            hits = self_intersections(pts, tr.triangles)
-        else:  # nothing optional to give up: the crossings are not looked for
-            hits = np.empty((0, 2), dtype=np.int64)
+        hits = _optional_crossings(pts, tr.triangles, (fot >= nb) | np.isin(fot, list(centres)))
         crossing = set(fot[hits.ravel()].tolist())
         drop = {f for f in crossing if f >= nb}
         for a, b in fot[hits].tolist():

@@ -23,6 +23,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
+from ._kernels import min_area_splits
 from ._validate import InputError, as_points
 from .cycles import CycleSet
 from .graph import cycle_edges
@@ -102,13 +103,6 @@ def orient_cycles(points: np.ndarray, faces: CycleSet) -> tuple[CycleSet, bool]:
     return oriented, orientable
 
 
-def _less(x: float, y: float, rtol: float) -> int:
-    """-1, 0 or 1: compare with a relative tie tolerance."""
-    if abs(x - y) <= rtol * max(abs(x), abs(y)):
-        return 0
-    return -1 if x < y else 1
-
-
 def _cmp(x: np.ndarray, y: np.ndarray, rtol: float) -> np.ndarray:
     """Elementwise -1, 0, 1 comparison with a relative tie tolerance."""
     tie = np.abs(x - y) <= rtol * np.maximum(np.abs(x), np.abs(y))
@@ -120,59 +114,29 @@ def _area(points, a, b, c):
 
 
 def _triangulate_polygon(points, cyc, forbidden: set, rtol: float):
-    """Minimum-area triangulation of one cycle avoiding ``forbidden`` diagonals."""
+    """Minimum-area triangulation of one cycle avoiding ``forbidden`` diagonals
+    (the dynamic programme is :func:`sr33._kernels.min_area_splits`)."""
     L = cyc.shape[0]
     if L == 3:
         return [tuple(int(v) for v in cyc)]
-    inf = float("inf")
-    cost = [[0.0] * L for _ in range(L)]
-    tie = [[0.0] * L for _ in range(L)]
-    split = [[-1] * L for _ in range(L)]
-
-    def allowed(i, j):
-        if j - i == 1 or (i == 0 and j == L - 1):
-            return True
-        a, b = int(cyc[i]), int(cyc[j])
-        return (min(a, b), max(a, b)) not in forbidden
-
-    for span in range(2, L):
-        for i in range(0, L - span):
-            j = i + span
-            best_c, best_t = inf, inf
-            if not allowed(i, j):
-                cost[i][j] = inf
-                continue
-            for m in range(i + 1, j):
-                if cost[i][m] == inf or cost[m][j] == inf:
-                    continue
-                area = float(_area(points, cyc[i], cyc[m], cyc[j]))
-                c = cost[i][m] + cost[m][j] + area
-                diag = tie[i][m] + tie[m][j]
-                if m - i > 1:
-                    diag += float(np.linalg.norm(points[cyc[i]] - points[cyc[m]]))
-                if j - m > 1:
-                    diag += float(np.linalg.norm(points[cyc[m]] - points[cyc[j]]))
-                cmp = _less(c, best_c, rtol) if best_c < inf else -1
-                if cmp == 0:
-                    cmp = _less(diag, best_t, rtol)
-                if cmp < 0:  # equal on both: the earlier split m wins
-                    best_c, best_t = c, diag
-                    cost[i][j] = c
-                    tie[i][j] = diag
-                    split[i][j] = m
-            if best_c == inf:
-                cost[i][j] = inf
-    if cost[0][L - 1] == inf:
+    c = [int(v) for v in cyc]
+    allowed = np.ones((L, L), dtype=bool)
+    for i in range(L):
+        for j in range(i + 2, L - (i == 0)):
+            if (min(c[i], c[j]), max(c[i], c[j])) in forbidden:
+                allowed[i, j] = False
+    split, feasible = min_area_splits(np.ascontiguousarray(points[cyc]), allowed, float(rtol))
+    if not feasible:
         # every diagonal choice is blocked: fall back to a fan from the first vertex
-        return [(int(cyc[0]), int(cyc[j]), int(cyc[j + 1])) for j in range(1, L - 1)]
+        return [(c[0], c[j], c[j + 1]) for j in range(1, L - 1)]
     out = []
     stack = [(0, L - 1)]
     while stack:
         i, j = stack.pop()
         if j - i < 2:
             continue
-        m = split[i][j]
-        out.append((int(cyc[i]), int(cyc[m]), int(cyc[j])))
+        m = int(split[i, j])
+        out.append((c[i], c[m], c[j]))
         stack.append((i, m))
         stack.append((m, j))
     return out

@@ -85,3 +85,28 @@ def naive_isometric_cycles(edges, n: int, max_len: int) -> set[tuple[int, ...]]:
         if ok:
             iso.add(cyc)
     return iso
+
+
+def naive_min_area_triangulation(points: np.ndarray, allowed: np.ndarray):
+    """Smallest total area over every triangulation of the polygon ``points``
+    (corners in order) whose chords are all ``allowed``; None if there is
+    none.  Enumerates the triangulations (Catalan many): small polygons only."""
+
+    def area(a, b, c):
+        return 0.5 * np.linalg.norm(np.cross(points[b] - points[a], points[c] - points[a]))
+
+    def best(i, j):
+        if j - i < 2:
+            return 0.0
+        out = None
+        for m in range(i + 1, j):
+            if not all(y - x == 1 or allowed[x, y] for x, y in ((i, m), (m, j))):
+                continue
+            left, right = best(i, m), best(m, j)
+            if left is None or right is None:
+                continue
+            total = left + right + area(i, m, j)
+            out = total if out is None else min(out, total)
+        return out
+
+    return best(0, len(points) - 1)

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sr33 import InputError, backtracking, localized_rng, triangulate, trivial_isometric_cycles
 from sr33.cycles import CycleSet
@@ -65,3 +67,39 @@ def test_bad_faces_argument():
         triangulate(pts, [[0, 1, 2]])
     with pytest.raises(InputError, match="faces index points out of range"):
         triangulate(pts, CycleSet(np.array([0, 3]), np.array([0, 1, 99])))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    L=st.integers(4, 8),
+    seed=st.integers(0, 2**32 - 1),
+    blocked=st.floats(0.0, 0.7),
+)
+def test_min_area_kernel_matches_every_triangulation_enumerated(L, seed, blocked):
+    """The numba dynamic programme finds the smallest area over all
+    triangulations whose chords are allowed (brute force, tests/naive.py),
+    and says so when there is none."""
+    from sr33._kernels import min_area_splits
+    from tests.naive import naive_min_area_triangulation
+
+    rng = np.random.default_rng(seed)
+    ang = np.sort(rng.uniform(0, 2 * np.pi, L))
+    p = np.stack([np.cos(ang), np.sin(ang), rng.normal(0, 0.4, L)], axis=1)
+    allowed = rng.random((L, L)) >= blocked
+    split, feasible = min_area_splits(p, allowed, 1e-9)
+    want = naive_min_area_triangulation(p, allowed)
+    assert feasible == (want is not None)
+    if want is None:
+        return
+    tri, stack = [], [(0, L - 1)]
+    while stack:
+        i, j = stack.pop()
+        if j - i >= 2:
+            m = int(split[i, j])
+            assert (
+                m > i and m < j and (m - i == 1 or allowed[i, m]) and (j - m == 1 or allowed[m, j])
+            )
+            tri.append((i, m, j))
+            stack += [(i, m), (m, j)]
+    assert len(tri) == L - 2
+    assert area(p, np.array(tri)) == pytest.approx(want, rel=1e-6)
