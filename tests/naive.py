@@ -110,3 +110,32 @@ def naive_min_area_triangulation(points: np.ndarray, allowed: np.ndarray):
         return out
 
     return best(0, len(points) - 1)
+
+
+def naive_flip_costs(points: np.ndarray, quad, across):
+    """Curvature cost (length times normal angle) of the five edges of the
+    flip of (p, q) to (r, s), before and after, and the largest new angle,
+    from the definition (reference of ``sr33._kernels.flip_costs``)."""
+    p, q, r, s = quad
+
+    def turn(t1, t2):
+        n1 = np.cross(points[t1[1]] - points[t1[0]], points[t1[2]] - points[t1[0]])
+        n2 = np.cross(points[t2[1]] - points[t2[0]], points[t2[2]] - points[t2[0]])
+        if not np.linalg.norm(n1) or not np.linalg.norm(n2):
+            return np.pi
+        c = n1 @ n2 / np.linalg.norm(n1) / np.linalg.norm(n2)
+        return float(np.arccos(np.clip(c, -1, 1)))
+
+    def length(a, b):
+        return float(np.linalg.norm(points[a] - points[b]))
+
+    t1, t2, new1, new2 = (p, q, r), (q, p, s), (r, p, s), (s, q, r)
+    outer = [(q, r), (r, p), (p, s), (s, q)]
+    before = length(p, q) * turn(t1, t2)
+    turns = [turn(new1, new2)]
+    after = length(r, s) * turns[0]
+    for k, (a, b) in enumerate(outer):
+        before += length(a, b) * turn(t1 if k < 2 else t2, across[k])
+        turns.append(turn(new2 if k in (0, 3) else new1, across[k]))
+        after += length(a, b) * turns[-1]
+    return before, after, max(turns)

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sr33 import InputError, attach_cones
 from sr33.validators import mesh_stats
@@ -84,3 +86,23 @@ def test_cones_on_a_bevel_are_flipped_back_to_the_sharp_edge(angle):
     edges = {tuple(e) for e in unique_edges(half_edges(out)[0]).tolist()}
     assert all((a, b) in edges for a, b in zip(ridge[:-1], ridge[1:]))
     assert out.shape[0] == tents.shape[0]
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), flat=st.booleans())
+def test_flip_cost_kernel_matches_its_definition(seed, flat):
+    """The numba cost of an edge flip equals the curvature from its
+    definition (tests/naive.py), degenerate (zero-area) triangles included."""
+    from sr33._kernels import flip_costs
+    from tests.naive import naive_flip_costs
+
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=(8, 3))
+    if flat:  # a zero-area triangle across one outer edge
+        pts[7] = 0.5 * (pts[1] + pts[3])
+    quad = np.array([0, 1, 2, 3])
+    across = np.array([[2, 1, 4], [0, 2, 5], [3, 0, 6], [1, 3, 7]])
+    t1, t2 = np.array([0, 1, 2]), np.array([1, 0, 3])
+    got = flip_costs(pts, t1, t2, quad, across)
+    want = naive_flip_costs(pts, quad, across)
+    assert np.allclose(got, want, rtol=1e-12, atol=1e-12)
