@@ -41,7 +41,7 @@ from scipy.spatial import cKDTree
 from .backtracking import links_are_disks
 from .cycles import CycleSet
 from .graph import cycle_edges
-from .mesh import edge_keys
+from .mesh import edge_keys, self_intersections
 
 
 @dataclass(frozen=True)
@@ -324,4 +324,54 @@ def unpinch(faces: CycleSet, n: int) -> np.ndarray:
             continue  # one piece that is not a path or cycle: left alone
         keep = min(count, key=lambda r: (-count[r], r))
         out |= {int(owner[k]) for k, r in zip(group.tolist(), roots) if r != keep}
+    return np.array(sorted(out), dtype=np.int64)
+
+
+def folded_corners(points, faces: CycleSet, triangles, face_of_triangle) -> np.ndarray:
+    """Faces folded onto each other at a sample they alone cover.
+
+    A sample used by exactly two faces that share both its edges (its link is
+    two arcs between the same two samples) is a disk combinatorially; it is
+    embedded only if the two faces leave it on opposite sides, as two halves
+    of a cone round its tip do.  Where the edge a search chose runs across
+    a sharp edge (the quad from the cone to the disk over a steep rim), the
+    two faces lie on one side and their triangles cross.  Those pairs are
+    returned; removing them leaves a hole round the sample that
+    :func:`hole_loops` closes and the sample to the cones, which insert it
+    back on the sharp edge.
+
+    Parameters
+    ----------
+    points : (n, 3) float
+    faces : CycleSet
+        The face cycles.
+    triangles : (t, 3) int64
+        Their triangulation.
+    face_of_triangle : (t,) int64
+        The face of every triangle.
+
+    Returns
+    -------
+    (r,) int64
+        Sorted indices of the folded faces.
+    """
+    if len(faces) == 0:
+        return np.empty(0, np.int64)
+    n = np.asarray(points).shape[0]
+    v, p, q = _corners(faces)
+    owner = np.repeat(np.arange(len(faces)), faces.lengths)
+    uses = np.bincount(v, minlength=n)
+    two = np.flatnonzero(uses[v] == 2)
+    if two.shape[0] == 0:
+        return np.empty(0, np.int64)
+    two = two[np.argsort(v[two], kind="stable")].reshape(-1, 2)
+    lo, hi = np.minimum(p[two], q[two]), np.maximum(p[two], q[two])
+    same = (lo[:, 0] == lo[:, 1]) & (hi[:, 0] == hi[:, 1])
+    out: set[int] = set()
+    tri = np.asarray(triangles, dtype=np.int64)
+    fot = np.asarray(face_of_triangle, dtype=np.int64)
+    for f1, f2 in owner[two[same]].tolist():
+        mine = np.flatnonzero((fot == f1) | (fot == f2))
+        if self_intersections(points, tri[mine]).shape[0]:
+            out |= {f1, f2}
     return np.array(sorted(out), dtype=np.int64)

@@ -20,7 +20,7 @@ from .backtracking import backtracking
 from .cones import attach_cones, ring_centres
 from .cycles import CycleSet, trivial_isometric_cycles
 from .graph import cycle_edges
-from .holes import HoleLoops, concat, face_links, hole_loops, uncovered, unpinch
+from .holes import HoleLoops, concat, face_links, folded_corners, hole_loops, uncovered, unpinch
 from .mesh import edge_keys, self_intersections
 from .progress import log, timed
 from .rng import localized_rng
@@ -244,17 +244,20 @@ def _close_holes(pts, base: CycleSet, max_hole_length: int, tolerance: Tolerance
     Returns the faces, their triangulation, the centres, the number of
     loop faces and the faces' figures.
     """
-    best = None
+    best, best_score = None, 0
     cur = base
     pieces = int(_piece_of_face(base, pts.shape[0]).max()) + 1 if len(base) else 0
     for _ in range(grow + 1):
         holes = hole_loops(pts, cur, max_length=max_hole_length) if max_hole_length else None
         faces, tr, centres, n_loops, flaps = _triangulate_with_loops(pts, cur, holes, tolerance)
         figs = _figures(faces, pts.shape[0])
-        if best is None or figs.defects < best[-1].defects:
-            best = (faces, tr, centres, n_loops, figs)
+        folds = folded_corners(pts, faces, tr.triangles, tr.face_of_triangle)
+        score = figs.defects + folds.shape[0]
+        if best is None or score < best_score:
+            best, best_score = (faces, tr, centres, n_loops, figs), score
         # the loops' base faces come first in ``faces``: unpinch on the base
         flaps |= set(unpinch(cur, pts.shape[0]).tolist())
+        flaps |= {int(f) for f in folds if f < len(cur)}
         if not flaps or not max_hole_length:
             break
         log.debug("hole loops: %d flaps and pinching faces removed", len(flaps))

@@ -298,15 +298,17 @@ DEEP_PROFILE_FAILURES = [
 ]
 
 
-@pytest.mark.xfail(reason="open: two quads with the same corner fold at the rim", strict=True)
-def test_open_failure_two_faces_with_one_corner_at_a_steep_cone_rim():
-    # the cone's rim (dihedral about 72 degrees): two quads share both edges
-    # at a rim sample (its link is two arcs between the same two samples)
-    # and cross; the search's link test accepts such a link (see the notes
-    # of issue 21: rejecting it moves Table 2's cone and conebox)
+def test_regression_two_faces_folded_at_one_corner_of_a_steep_cone_rim():
+    # the cone's rim (dihedral about 72 degrees): two quads, one of them
+    # across the rim, share both edges at a rim sample (its link is two arcs
+    # between the same two samples) and cross; they are removed, the quad
+    # hole they leave is closed and the sample coned back onto the rim
+    # (sr33.holes.folded_corners)
     s = shapes.build("cone", radius=0.5, height=1.5)
     r = scan(s, s.default_spacing, ratio=0.8515625, repair=False)
-    check_homeomorphism(s, r.points, r.meta["spacing"], reconstruct(r.points, 33))
+    rec = reconstruct(r.points, 33)
+    check_homeomorphism(s, r.points, r.meta["spacing"], rec)
+    assert rec.coned_samples.shape[0] >= 1 and rec.hole_faces >= 1
 
 
 @pytest.mark.parametrize("name, params, density, ratio", DEEP_PROFILE_FAILURES)
