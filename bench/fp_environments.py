@@ -138,9 +138,7 @@ def figures(name: str, path: Path) -> dict:
         "open": int(st.open_edges),
         "overloaded": int(st.overloaded_edges),
         "euler": int(st.euler),
-        "conforms": bool(
-            violating == 0 and cover <= 1.5 * h and closest >= 0.25 * h
-        ),
+        "conforms": bool(violating == 0 and cover <= 1.5 * h and closest >= 0.25 * h),
         "topology_ok": bool(
             st.overloaded_edges == 0
             and st.euler == e.euler

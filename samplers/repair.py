@@ -613,7 +613,10 @@ def _attempts(start: _Problem, first, descent_steps: int, max_edits: int):
         best = min((best, answer), key=_rank)
     log.debug(
         "repair attempts: first %d bad (worst %.3f), kept %d bad (worst %.3f)",
-        first[1], first[2], best[1], best[2],
+        first[1],
+        first[2],
+        best[1],
+        best[2],
     )
     return best
 

@@ -622,7 +622,6 @@ def _fill_gaps(occ, faces, points: np.ndarray, h: float, size: float) -> np.ndar
     import cadquery as cq
     from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 
-
     tv, tt = occ.tessellate(size / 500.0, 0.1)
     if not tt:
         return np.empty((0, 3))
