@@ -140,8 +140,18 @@ def attach_cones(
     owner: dict[tuple[int, int], int] = {}
     for i, (a, b, c) in enumerate(tris):
         owner[a, b] = owner[b, c] = owner[c, a] = i
-    tree = cKDTree(pts[tri].mean(axis=1))
+    cen0 = pts[tri].mean(axis=1)
+    tree = cKDTree(cen0)
     kq = min(candidates, len(tris))
+    # every triangle lies in the hull of its corners, which are its input
+    # ancestor's corners or samples inserted into it: ``rad[o]`` bounds their
+    # distance from ancestor o's centroid, so every triangle an insertion can
+    # cross descends from an ancestor within the new triangles' span plus
+    # ``rad`` of the stray: the usual ancestors are found in the tree (within
+    # span plus ``small``), the few long ones (loop faces) are always tried
+    rad = norm(pts[tri] - cen0[:, None]).max(axis=1)
+    small = 4.0 * float(np.median(rad))
+    long_ones = set(np.flatnonzero(rad > small).tolist())
 
     def replace(old: list[int], new: list[tuple[int, int, int]], src: list[int]) -> None:
         for i in old:
@@ -164,10 +174,13 @@ def attach_cones(
         cand = sorted({j for o in np.atleast_1d(near).tolist() for j in family[o]})
         options = _insertions(pts, p, cand, tris, owner)
         solid = [o for o in options if not _flat(pts, o[2])] or options
-        local = np.array([tris[i] for i in cand], dtype=np.int64)
+        span = max(float(norm(pts[np.array(o[2]).ravel()] - pts[p]).max()) for o in solid)
+        near_all = tree.query_ball_point(pts[p], span + small)
+        around = sorted({j for o in list(near_all) + sorted(long_ones) for j in family[o]})
+        local = np.array([tris[i] for i in around], dtype=np.int64).reshape(-1, 3)
         pick = None
         for _, old, new in solid:
-            keep_i = [k for k, i in enumerate(cand) if i not in old]
+            keep_i = [k for k, i in enumerate(around) if i not in old]
             patch = np.vstack([np.array(new, dtype=np.int64), local[keep_i]])
             m = len(new)
             hits = self_intersections(pts, patch, keep=lambda a, b, m=m: (a < m) | (b < m))
@@ -178,6 +191,10 @@ def attach_cones(
             pick = solid[0][1:]
         old, new = pick
         o0, o1 = origin[old[0]], origin[old[-1]]
+        for o in (o0, o1):
+            rad[o] = max(rad[o], float(norm(pts[p] - cen0[o])))
+            if rad[o] > small:
+                long_ones.add(o)
         replace(old, new, [o0] * 3 if len(old) == 1 else [o0, o0, o1, o1])
     out = np.array([t for t, ok in zip(tris, alive) if ok], dtype=np.int64)
     if flips:
@@ -240,7 +257,7 @@ def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
     (p, q, r) and (q, p, s), with p or q near a seed, is replaced by (r, s)
     when that lowers the cost of the five edges involved by more than 1e-9
     relative, (r, s) is not already an edge, no new angle exceeds 165°, and
-    neither new triangle crosses a triangle within reach.  Edges are visited
+    neither new triangle crosses another triangle.  Edges are visited
     in a fixed order, ``rounds`` times at most: deterministic.  Used after
     :func:`attach_cones` (Section 5's cones).
 
@@ -263,7 +280,6 @@ def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
     if tri.shape[0] < 2 or seeds.shape[0] == 0:
         return tri
     pts = np.asarray(points, dtype=np.float64)
-    reach = 4.0 * float(np.median(norm(pts[tri[:, 0]] - pts[tri[:, 1]])))
     near = np.zeros(pts.shape[0], dtype=bool)
     near[seeds] = True
     for _ in range(2):  # two rings round the seeds
@@ -285,6 +301,7 @@ def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
     for _ in range(rounds):
         cen = pts[tri].mean(axis=1)
         tree = cKDTree(cen)
+        radius = float(norm(pts[tri] - cen[:, None]).max())  # no crossing triangle is missed
         edges = sorted({(min(a, b), max(a, b)) for (a, b) in owner if near[a] or near[b]})
         flipped = 0
         for p, q in edges:
@@ -309,7 +326,8 @@ def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
                 continue
             new = np.stack([new1, new2])
             mid = pts[new].mean(axis=(0, 1))
-            local = [k for k in tree.query_ball_point(mid, reach) if k != i and k != j]
+            ext = float(norm(pts[new.ravel()] - mid).max())
+            local = [k for k in tree.query_ball_point(mid, ext + radius) if k != i and k != j]
             patch = np.vstack([new, tri[local]]) if local else new
             if self_intersections(pts, patch, keep=lambda a, b: (a < 2) | (b < 2)).shape[0]:
                 continue

@@ -327,51 +327,38 @@ def unpinch(faces: CycleSet, n: int) -> np.ndarray:
     return np.array(sorted(out), dtype=np.int64)
 
 
-def folded_corners(points, faces: CycleSet, triangles, face_of_triangle) -> np.ndarray:
-    """Faces folded onto each other at a sample they alone cover.
+def crossing_faces(points, triangles, face_of_triangle, n_faces: int) -> np.ndarray:
+    """Faces among the first ``n_faces`` whose triangles cross each other's.
 
-    A sample used by exactly two faces that share both its edges (its link is
-    two arcs between the same two samples) is a disk combinatorially; it is
-    embedded only if the two faces leave it on opposite sides, as two halves
-    of a cone round its tip do.  Where the edge a search chose runs across
-    a sharp edge (the quad from the cone to the disk over a steep rim), the
-    two faces lie on one side and their triangles cross.  Those pairs are
-    returned; removing them leaves a hole round the sample that
-    :func:`hole_loops` closes and the sample to the cones, which insert it
-    back on the sharp edge.
+    The search excludes crossing candidate cycles, but not those that share
+    a corner, and those can still cross: two faces that alone cover a
+    sample and share both its edges are a disk combinatorially, yet folded
+    onto each other when they lie on one side of it (a quad run across a
+    steep cone rim beside a quad of the cone).  Both faces of every crossing
+    pair are returned; removing them leaves a hole that :func:`hole_loops`
+    closes, and the sample they alone covered goes to the cones, which
+    insert it back where nothing crosses.
 
     Parameters
     ----------
     points : (n, 3) float
-    faces : CycleSet
-        The face cycles.
     triangles : (t, 3) int64
-        Their triangulation.
+        The triangulation of the faces.
     face_of_triangle : (t,) int64
         The face of every triangle.
+    n_faces : int
+        Faces ``0 .. n_faces - 1`` are considered (the selection's; loop
+        faces after them are checked on their own).
 
     Returns
     -------
     (r,) int64
-        Sorted indices of the folded faces.
+        Sorted indices of the crossing faces.
     """
-    if len(faces) == 0:
-        return np.empty(0, np.int64)
-    n = np.asarray(points).shape[0]
-    v, p, q = _corners(faces)
-    owner = np.repeat(np.arange(len(faces)), faces.lengths)
-    uses = np.bincount(v, minlength=n)
-    two = np.flatnonzero(uses[v] == 2)
-    if two.shape[0] == 0:
-        return np.empty(0, np.int64)
-    two = two[np.argsort(v[two], kind="stable")].reshape(-1, 2)
-    lo, hi = np.minimum(p[two], q[two]), np.maximum(p[two], q[two])
-    same = (lo[:, 0] == lo[:, 1]) & (hi[:, 0] == hi[:, 1])
-    out: set[int] = set()
     tri = np.asarray(triangles, dtype=np.int64)
     fot = np.asarray(face_of_triangle, dtype=np.int64)
-    for f1, f2 in owner[two[same]].tolist():
-        mine = np.flatnonzero((fot == f1) | (fot == f2))
-        if self_intersections(points, tri[mine]).shape[0]:
-            out |= {f1, f2}
-    return np.array(sorted(out), dtype=np.int64)
+    mine = np.flatnonzero(fot < n_faces)
+    if mine.shape[0] < 2:
+        return np.empty(0, np.int64)
+    hits = self_intersections(points, tri[mine])
+    return np.unique(fot[mine[hits.ravel()]]).astype(np.int64)

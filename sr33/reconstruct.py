@@ -20,7 +20,7 @@ from .backtracking import backtracking
 from .cones import attach_cones, ring_centres
 from .cycles import CycleSet, trivial_isometric_cycles
 from .graph import cycle_edges
-from .holes import HoleLoops, concat, face_links, folded_corners, hole_loops, uncovered, unpinch
+from .holes import HoleLoops, concat, crossing_faces, face_links, hole_loops, uncovered, unpinch
 from .mesh import edge_keys, self_intersections
 from .progress import log, timed
 from .rng import localized_rng
@@ -235,12 +235,13 @@ def _piece_of_face(faces: CycleSet, n: int) -> np.ndarray:
 def _close_holes(pts, base: CycleSet, max_hole_length: int, tolerance: Tolerance, grow: int = 6):
     """The selection with its boundary loops closed (:mod:`sr33.holes`).
 
-    Where a loop face crossed faces folded over its hole (flaps), or where
-    a sample's faces form several pieces (:func:`sr33.holes.unpinch`), those
-    faces are removed and the larger hole's loop is tried instead, up to
+    Where a loop face crossed faces folded over its hole (flaps), where
+    a sample's faces form several pieces (:func:`sr33.holes.unpinch`), or
+    where two faces of the selection cross (:func:`sr33.holes.crossing_faces`),
+    those faces are removed and the larger hole's loop is tried instead, up to
     ``grow`` times; pieces of the surface that removing flaps detaches are removed
     too (their samples go to the cones); the round with the fewest open
-    edges plus pinched samples (then the first) is kept.
+    edges plus pinched samples plus crossing faces (then the first) is kept.
     Returns the faces, their triangulation, the centres, the number of
     loop faces and the faces' figures.
     """
@@ -251,13 +252,13 @@ def _close_holes(pts, base: CycleSet, max_hole_length: int, tolerance: Tolerance
         holes = hole_loops(pts, cur, max_length=max_hole_length) if max_hole_length else None
         faces, tr, centres, n_loops, flaps = _triangulate_with_loops(pts, cur, holes, tolerance)
         figs = _figures(faces, pts.shape[0])
-        folds = folded_corners(pts, faces, tr.triangles, tr.face_of_triangle)
+        folds = crossing_faces(pts, tr.triangles, tr.face_of_triangle, len(cur))
         score = figs.defects + folds.shape[0]
         if best is None or score < best_score:
             best, best_score = (faces, tr, centres, n_loops, figs), score
         # the loops' base faces come first in ``faces``: unpinch on the base
         flaps |= set(unpinch(cur, pts.shape[0]).tolist())
-        flaps |= {int(f) for f in folds if f < len(cur)}
+        flaps |= set(folds.tolist())
         if not flaps or not max_hole_length:
             break
         log.debug("hole loops: %d flaps and pinching faces removed", len(flaps))

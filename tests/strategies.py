@@ -60,14 +60,6 @@ def rotation(angle_seed: int) -> np.ndarray:
 
 # --- library shapes and scan settings (the paper's guarantees) --------------------
 
-# sharp edges with dihedral angles below 60 degrees.  Their default
-# (repaired, conforming) samplings reconstruct homeomorphic (issue 21, see
-# test_every_library_shape_reconstructs_homeomorphic); the property below
-# samples plain scan rows (repair=False), which do not meet Condition III
-# at such edges, so its examples for them are expected to fail until the
-# property checks conformance (issue 24)
-ACUTE_SHAPES = ("pyramid", "star_prism", "wedge")
-
 
 @st.composite
 def shape_params(draw, name: str) -> dict[str, float]:

@@ -106,3 +106,29 @@ def test_flip_cost_kernel_matches_its_definition(seed, flat):
     got = flip_costs(pts, t1, t2, quad, across)
     want = naive_flip_costs(pts, quad, across)
     assert np.allclose(got, want, rtol=1e-12, atol=1e-12)
+
+
+def test_an_insertion_never_crosses_a_long_triangle_whose_centroid_is_far():
+    """A sliver reaching from far away to just beside a stray sample crosses
+    the cone over the triangle under the sample, not a cone one cell over:
+    the crossing check must see the sliver although it is not among the
+    triangles nearest the sample (a crossing cheburashka once got)."""
+    from sr33.validators.intersections import self_intersections
+
+    xs, ys = np.meshgrid(np.arange(31.0), np.arange(3.0), indexing="ij")
+    grid = np.stack([xs.ravel(), ys.ravel(), np.zeros(xs.size)], axis=1)
+    idx = np.arange(xs.size).reshape(xs.shape)
+    tri = []
+    for i in range(30):
+        for j in range(2):
+            a, b, c, d = idx[i, j], idx[i + 1, j], idx[i + 1, j + 1], idx[i, j + 1]
+            tri += [(a, b, d), (b, c, d)]
+    m = grid.shape[0]
+    sliver = np.array([[1.3, 0.45, 0.05], [40.0, 0.40, 0.05], [40.0, 0.50, 0.05]])
+    stray = np.array([[1.5, 0.45, 0.1]])
+    pts = np.vstack([grid, sliver, stray])
+    tri.append((m, m + 1, m + 2))
+    out, strays = attach_cones(pts, tri, flips=False)
+    assert strays.tolist() == [m + 3]
+    assert (out == m + 3).any()
+    assert self_intersections(pts, out).shape[0] == 0

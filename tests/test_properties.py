@@ -5,18 +5,24 @@ few examples per property inside ``make test``; ``make fuzz`` runs the
 ``deep`` profile and prints, per property, the examples run, failures and
 seconds.
 
-The shapes are sampled from the plain scan rows (``repair=False``): the
-boundary-layer repair costs seconds per shape, which hypothesis would pay on
-every example; its effect on Condition III is tested in
-``tests/test_sampling_shapes.py``, and ``bench/samplers_report.py``
-reconstructs every repaired default sampling.
+Two homeomorphism properties cover the library shapes.  With drawn
+parameters, shapes are sampled from the plain scan rows (``repair=False``):
+the boundary-layer repair costs seconds per shape, which hypothesis would
+pay on every example.  Plain rows across an edge sharper than 60 degrees
+break Condition III (the geodesic check found none of a dozen such draws
+conforming), so shapes with such edges are not drawn there; instead every
+shape's repaired default sampling, which meets Condition III by the
+geodesic check (``tests/test_sampling_shapes.py``), is reconstructed under
+drawn rigid motions, scalings and point orders.  Until the sampler is fast
+and general (issue 23) the drawn-parameter property cannot measure
+conformance per example (issue 24).
 """
 
 import os
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, Phase, assume, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 pytest.importorskip("cadquery")
@@ -30,7 +36,6 @@ from sr33.validators.signature import homeomorphic, signature  # noqa: E402
 from tests.fuzzstats import count  # noqa: E402
 from tests.helpers import check_homeomorphism, triangle_set  # noqa: E402
 from tests.strategies import (  # noqa: E402
-    ACUTE_SHAPES,
     arbitrary_points,
     rigid_motions,
     scan_settings,
@@ -57,10 +62,23 @@ def sample_shape(name, params, cfg):
     return s, r
 
 
+def _acute(shape, below_degrees: float = 60.0) -> bool:
+    """Whether the shape's truth has an edge whose interior dihedral angle is
+    below ``below_degrees`` (where plain scan rows break Condition III-ii:
+    the Euclidean RNG cuts across such edges, issue 21)."""
+    from sr33.validators.fidelity import dihedral_pairs
+
+    _, _, _, cos = dihedral_pairs(shape.truth_vertices, shape.truth_triangles)
+    return bool(cos.size) and float(cos.min()) < np.cos(np.radians(180.0 - below_degrees))
+
+
 def _homeomorphism_case(name, data):
     params = data.draw(shape_params(name), label="params")
     cfg = data.draw(scan_settings(), label="scan")
     s, r = sample_shape(name, params, cfg)
+    # plain scan rows across an acute edge break Condition III (the geodesic
+    # check finds 0 of 12 such draws conforming): not the theorem's input
+    assume(not _acute(s))
     rec = reconstruct(r.points, 33)
     count(f"homeomorphism[{name}]")
     check_homeomorphism(s, r.points, r.meta["spacing"], rec)
@@ -71,22 +89,75 @@ def _homeomorphism_case(name, data):
 # cone_tip got a zero-area triangle (apex_height 1.0625) and crossing
 # triangles near its tip (ratio 1.125); conebox crossing triangles at its
 # apex (ratio 0.875).
-KNOWN_FAILING: tuple[str, ...] = ()
-CONFORMING = [n for n in shapes.shape_names() if n not in ACUTE_SHAPES + KNOWN_FAILING]
-# known failures: one example, no shrinking, so they cost little in CI
-KNOWN = settings(
-    max_examples=PER_SHAPE // 2 or 1,
-    deadline=None,
-    phases=[Phase.explicit, Phase.generate],
-    suppress_health_check=list(HealthCheck),
-)
 
 
-@pytest.mark.parametrize("name", CONFORMING)
+# shapes whose edges are all 60 degrees or wider: their plain scan rows are
+# drawn; the others (acute edges) are tested on their conforming default
+# samplings below
+PLAIN_ROWS = [n for n in shapes.shape_names() if not _acute(shapes.build(n))]
+
+
+@pytest.mark.parametrize("name", PLAIN_ROWS)
 @HEAVY
 @given(data=st.data())
 def test_homeomorphism_of_conforming_samples(name, data):
+    """Theorems 3-5 on the library shapes, their parameters drawn, sampled by
+    plain scan rows."""
     _homeomorphism_case(name, data)
+
+
+# the repaired default samplings (Condition III by the geodesic check in
+# tests/test_sampling_shapes.py), made once per session
+_DEFAULT_SAMPLINGS: dict = {}
+# reconstructions quick enough for `make test`; the others run in `make check`
+_QUICK_MOTION = {"cube", "L_sheet", "pyramid", "cylinder"}
+
+
+def _default_sampling(name):
+    if name not in _DEFAULT_SAMPLINGS:
+        s = shapes.build(name)
+        _DEFAULT_SAMPLINGS[name] = (s, scan(s))
+    return _DEFAULT_SAMPLINGS[name]
+
+
+# a known failure, kept as a named regression: under the rotation the
+# derandomized profile draws first, star_prism's selection bevels its 40
+# degree edges (chords one sample in, the edge samples on thin fins), so
+# the surface strays 1.07 h from the truth; homeomorphic, no crossing
+_BEVELS = pytest.mark.xfail(
+    reason="star_prism rotated: an acute edge bevelled, Hausdorff 1.07 h (issue 21)", strict=True
+)
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(
+            n,
+            marks=([] if n in _QUICK_MOTION else [pytest.mark.slow])
+            + ([_BEVELS] if n == "star_prism" else []),
+        )
+        for n in shapes.shape_names()
+    ],
+)
+@settings(
+    max_examples=1 if not DEEP else 12, deadline=None, suppress_health_check=list(HealthCheck)
+)
+@given(motion=rigid_motions(), perm_seed=st.integers(0, 2**31))
+def test_homeomorphism_of_default_samplings_under_rigid_motions(name, motion, perm_seed):
+    """Every library shape's conforming default sampling, moved, scaled and
+    shuffled: homeomorphic, crossing-free, every sample a vertex, Hausdorff
+    at most h (acute edges included: pyramid, star_prism, wedge)."""
+    s, r = _default_sampling(name)
+    rot, t, scale = motion
+    perm = np.random.default_rng(perm_seed).permutation(r.points.shape[0])
+    moved = (r.points[perm] @ rot.T) * scale + t
+    rec = reconstruct(moved, 33)
+    count(f"rigid motion[{name}]")
+    back = ((rec.vertices - t) / scale) @ rot  # into the shape's frame
+    check_homeomorphism(
+        s, r.points, r.meta["spacing"], Reconstruction(**{**rec.__dict__, "vertices": back})
+    )
 
 
 @pytest.mark.parametrize(
@@ -101,15 +172,6 @@ def test_regression_crossing_faces_at_cone_tips(name, params, ratio):
     s = shapes.build(name, **params)
     r = scan(s, ratio=ratio, repair=False)
     check_homeomorphism(s, r.points, r.meta["spacing"], reconstruct(r.points, 33))
-
-
-@pytest.mark.parametrize("name", ACUTE_SHAPES + KNOWN_FAILING)
-@pytest.mark.xfail(reason="known failure, see the README and the closing note", strict=False)
-@KNOWN
-@given(data=st.data())
-def test_sharp_features_theorems_3_and_4(name, data):
-    # the cone (apex and rim) is in the conforming set above
-    _homeomorphism_case(name, data)
 
 
 def test_the_homeomorphism_property_can_fail():
@@ -303,7 +365,7 @@ def test_regression_two_faces_folded_at_one_corner_of_a_steep_cone_rim():
     # across the rim, share both edges at a rim sample (its link is two arcs
     # between the same two samples) and cross; they are removed, the quad
     # hole they leave is closed and the sample coned back onto the rim
-    # (sr33.holes.folded_corners)
+    # (sr33.holes.crossing_faces)
     s = shapes.build("cone", radius=0.5, height=1.5)
     r = scan(s, s.default_spacing, ratio=0.8515625, repair=False)
     rec = reconstruct(r.points, 33)
