@@ -327,28 +327,36 @@ def unpinch(faces: CycleSet, n: int) -> np.ndarray:
     return np.array(sorted(out), dtype=np.int64)
 
 
-def crossing_faces(points, triangles, face_of_triangle, n_faces: int) -> np.ndarray:
+def crossing_faces(
+    points, faces: CycleSet, triangles, face_of_triangle, n_faces: int, *, everywhere: bool = True
+) -> np.ndarray:
     """Faces among the first ``n_faces`` whose triangles cross each other's.
 
     The search excludes crossing candidate cycles, but not those that share
-    a corner, and those can still cross: two faces that alone cover a
-    sample and share both its edges are a disk combinatorially, yet folded
-    onto each other when they lie on one side of it (a quad run across a
-    steep cone rim beside a quad of the cone).  Both faces of every crossing
-    pair are returned; removing them leaves a hole that :func:`hole_loops`
-    closes, and the sample they alone covered goes to the cones, which
-    insert it back where nothing crosses.
+    a corner, and those can still cross.  Above all, two faces that alone
+    cover a sample and share both its edges are a disk combinatorially, yet
+    folded onto each other when they lie on one side of it (a quad run
+    across a steep cone rim beside a quad of the cone); such pairs are
+    always checked, every other pair of faces only with ``everywhere`` (a
+    selection the strict search did not make alone).  Both faces of every
+    crossing pair are returned; removing them leaves a hole that
+    :func:`hole_loops` closes, and a sample only they covered goes to the
+    cones, which insert it back where nothing crosses.
 
     Parameters
     ----------
     points : (n, 3) float
+    faces : CycleSet
+        The face cycles (the selection's first, loop faces after them).
     triangles : (t, 3) int64
-        The triangulation of the faces.
+        Their triangulation.
     face_of_triangle : (t,) int64
         The face of every triangle.
     n_faces : int
         Faces ``0 .. n_faces - 1`` are considered (the selection's; loop
-        faces after them are checked on their own).
+        faces are checked on their own).
+    everywhere : bool
+        Check every pair of faces, not only the folded pairs.
 
     Returns
     -------
@@ -357,8 +365,24 @@ def crossing_faces(points, triangles, face_of_triangle, n_faces: int) -> np.ndar
     """
     tri = np.asarray(triangles, dtype=np.int64)
     fot = np.asarray(face_of_triangle, dtype=np.int64)
-    mine = np.flatnonzero(fot < n_faces)
-    if mine.shape[0] < 2:
-        return np.empty(0, np.int64)
-    hits = self_intersections(points, tri[mine])
-    return np.unique(fot[mine[hits.ravel()]]).astype(np.int64)
+    out: set[int] = set()
+    if everywhere:
+        mine = np.flatnonzero(fot < n_faces)
+        if mine.shape[0] >= 2:
+            hits = self_intersections(points, tri[mine])
+            out |= set(fot[mine[hits.ravel()]].tolist())
+    elif len(faces):
+        n = np.asarray(points).shape[0]
+        v, p, q = _corners(faces)
+        owner = np.repeat(np.arange(len(faces)), faces.lengths)
+        base = owner < n_faces
+        uses = np.bincount(v[base], minlength=n)
+        two = np.flatnonzero(base & (uses[v] == 2))
+        two = two[np.argsort(v[two], kind="stable")].reshape(-1, 2)
+        lo, hi = np.minimum(p[two], q[two]), np.maximum(p[two], q[two])
+        same = (lo[:, 0] == lo[:, 1]) & (hi[:, 0] == hi[:, 1])
+        for f1, f2 in owner[two[same]].tolist():
+            pair = np.flatnonzero((fot == f1) | (fot == f2))
+            if self_intersections(points, tri[pair]).shape[0]:
+                out |= {f1, f2}
+    return np.array(sorted(out), dtype=np.int64)

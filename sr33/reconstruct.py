@@ -232,7 +232,14 @@ def _piece_of_face(faces: CycleSet, n: int) -> np.ndarray:
     return np.unique(first, return_inverse=True)[1].reshape(-1)
 
 
-def _close_holes(pts, base: CycleSet, max_hole_length: int, tolerance: Tolerance, grow: int = 6):
+def _close_holes(
+    pts,
+    base: CycleSet,
+    max_hole_length: int,
+    tolerance: Tolerance,
+    grow: int = 6,
+    everywhere: bool = True,
+):
     """The selection with its boundary loops closed (:mod:`sr33.holes`).
 
     Where a loop face crossed faces folded over its hole (flaps), where
@@ -252,7 +259,9 @@ def _close_holes(pts, base: CycleSet, max_hole_length: int, tolerance: Tolerance
         holes = hole_loops(pts, cur, max_length=max_hole_length) if max_hole_length else None
         faces, tr, centres, n_loops, flaps = _triangulate_with_loops(pts, cur, holes, tolerance)
         figs = _figures(faces, pts.shape[0])
-        folds = crossing_faces(pts, tr.triangles, tr.face_of_triangle, len(cur))
+        folds = crossing_faces(
+            pts, faces, tr.triangles, tr.face_of_triangle, len(cur), everywhere=everywhere
+        )
         score = figs.defects + folds.shape[0]
         if best is None or score < best_score:
             best, best_score = (faces, tr, centres, n_loops, figs), score
@@ -361,7 +370,10 @@ def reconstruct(
             quiet=quiet,
         )
     with timed("triangulate", timings):
-        faces, tr, centres, n_loops, figs = _close_holes(pts, sel.faces, max_hole_length, tolerance)
+        # a selection the strict search made alone is checked for folds only
+        faces, tr, centres, n_loops, figs = _close_holes(
+            pts, sel.faces, max_hole_length, tolerance, everywhere=sel.fallback_components > 0
+        )
         tri = tr.triangles
     if strict_default() if strict is None else strict:
         with timed("self_checks", timings):
