@@ -5,10 +5,20 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import sys
 from pathlib import Path
 
 from ._validate import InputError
+
+EXIT_CODES = """exit codes:
+  0  done, and the result passes its check (reconstruct: the success
+     condition; validate: a valid mesh, homeomorphic and within h of the
+     truth; conditions: every condition met)
+  1  done, but the result fails its check (the outputs are still written)
+  2  bad input or output (one line on stderr naming the problem)
+  3  internal error (one line; the traceback with -v)
+  130  interrupted; 143 terminated (no temporary file is left)"""
 
 STEPS = ("localized_rng", "isometric_cycles", "backtracking", "triangulate", "cones")
 
@@ -36,10 +46,18 @@ def _stats_rows(stats) -> list[tuple[str, str]]:
 def _cmd_reconstruct(args) -> int:
     from sr33.validators.topology import mesh_stats
 
-    from .io import read_points, write_mesh, write_text
+    from .io import MESH_FORMATS, TEXT_FORMATS, read_points, write_mesh, write_text
     from .reconstruct import reconstruct
 
     out = Path(args.output)
+    _check_outputs(
+        [
+            (args.output, MESH_FORMATS, "output"),
+            (args.json, TEXT_FORMATS, "text"),
+            (args.save, (".npz",), "reconstruction"),
+        ],
+        inputs=[args.input],
+    )
     points = read_points(args.input)
     r = reconstruct(
         points,
@@ -79,7 +97,26 @@ def _cmd_reconstruct(args) -> int:
             "seconds": r.timings,
         }
         write_text(args.json, json.dumps(doc, indent=2) + "\n")
-    return 0
+    if r.triangles.shape[0] == 0:
+        print("sr33: the mesh has no faces", file=sys.stderr)
+        return 1
+    return 0 if r.success else 1
+
+
+def _check_outputs(outputs, inputs) -> None:
+    """Check every output path before the work: writable, a known format,
+    none equal to an input or to another output."""
+    from .io import check_output
+
+    seen: dict[Path, str] = {Path(p).resolve(): "input" for p in inputs if p}
+    for path, formats, what in outputs:
+        if not path:
+            continue
+        check_output(path, formats, what)
+        key = Path(path).resolve()
+        if key in seen:
+            raise InputError(f"{path}: is also the {seen[key]}; give the {what} another path")
+        seen[key] = f"{what} file"
 
 
 def _cmd_stats(args) -> int:
@@ -123,7 +160,16 @@ def _cmd_sample(args) -> int:
         raise InputError("sample needs a SHAPE name (see sr33 sample --list)")
     if not args.output:
         raise InputError("sample needs -o/--output for the points")
-    from .io import write_mesh, write_points
+    from .io import MESH_FORMATS, POINT_FORMATS, TEXT_FORMATS, write_mesh, write_points
+
+    _check_outputs(
+        [
+            (args.output, POINT_FORMATS, "point"),
+            (args.truth, MESH_FORMATS, "truth mesh"),
+            (args.meta, TEXT_FORMATS, "text"),
+        ],
+        inputs=[],
+    )
 
     try:
         shape = shapes.build(args.shape, **_parse_params(args.param))
@@ -204,6 +250,11 @@ def _cmd_validate(args) -> int:
         rows.append(("input points not vertices", str(missing)))
         doc["points_not_vertices"] = missing
     ok = sig.manifold and sig.orientable and crossing.shape[0] == 0 and stats.overloaded_edges == 0
+    ok = ok and not (args.points and missing)
+    if args.json:
+        from .io import TEXT_FORMATS
+
+        _check_outputs([(args.json, TEXT_FORMATS, "text")], inputs=[args.mesh, args.truth])
     if args.truth:
         from sr33.validators.fidelity import hausdorff
 
@@ -220,7 +271,8 @@ def _cmd_validate(args) -> int:
             ("Hausdorff / h", f"{fid.hausdorff_h:.4f}"),
             ("mean distance / h", f"{fid.mean_h:.4f}"),
         ]
-        ok = bool(verdict) and crossing.shape[0] == 0
+        ok = bool(verdict) and crossing.shape[0] == 0 and fid.hausdorff_h <= 1.0
+        ok = ok and not (args.points and missing)
         doc["homeomorphic"] = bool(verdict)
         doc["reasons"] = list(verdict.reasons)
         doc["hausdorff_h"] = fid.hausdorff_h
@@ -248,9 +300,10 @@ def _cmd_conditions(args) -> int:
         raise InputError(str(exc)) from None
     width = max(len(r[0]) for r in rep.table())
     print(f"{'condition':<{width}}  {'result':<12}  {'measured':<10}  worst samples")
-    for name, res, fig, worst in rep.table():
+    rows = rep.table()
+    for name, res, fig, worst in rows:
         print(f"{name:<{width}}  {res:<12}  {fig:<10}  {worst}")
-    return 0
+    return 1 if any(res == "FAIL" for _, res, _, _ in rows) else 0
 
 
 def _cmd_view(args) -> int:
@@ -334,15 +387,43 @@ def _mesh_as_reconstruction(v, f, k):
     )
 
 
+class _DefaultsShown(argparse.ArgumentDefaultsHelpFormatter):
+    """Shows real defaults in --help, not ``None`` or ``False`` for unset options."""
+
+    def _get_help_string(self, action):
+        if action.default in (None, False, argparse.SUPPRESS) or action.default == []:
+            return action.help
+        return super()._get_help_string(action)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
-        prog="sr33", description="Reconstruct surfaces with sharp features from point samples."
+    from importlib.metadata import version
+
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument(
+        "-v",
+        "--verbose",
+        action="store_true",
+        default=argparse.SUPPRESS,
+        help="log step timings (debug) and show tracebacks of internal errors",
     )
-    p.add_argument("-v", "--verbose", action="store_true", help="log step timings (debug)")
+    fmt = _DefaultsShown
+    p = argparse.ArgumentParser(
+        prog="sr33",
+        description="Reconstruct surfaces with sharp features from point samples.",
+        epilog=EXIT_CODES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        parents=[common],
+    )
+    p.add_argument("--version", action="version", version=f"sr33 {version('sr33')}")
     sub = p.add_subparsers(dest="command", required=True)
-    r = sub.add_parser("reconstruct", help="reconstruct a mesh from samples")
+
+    def add(name, help_):
+        return sub.add_parser(name, help=help_, parents=[common], formatter_class=fmt)
+
+    r = add("reconstruct", "reconstruct a mesh from samples")
     r.add_argument("input", help="samples: .xyz .txt .npy or a mesh .ply .obj .off .stl .vtp")
-    r.add_argument("-k", type=int, default=33, help="neighbourhood size (default 33)")
+    r.add_argument("-k", type=int, default=33, help="neighbourhood size")
     r.add_argument("-o", "--output", required=True, help="output mesh .ply .obj .off .stl .vtp")
     r.add_argument("--max-cycle-length", type=int, default=8, help="longest face cycle")
     r.add_argument("--budget", type=int, default=20000, help="search budget per component")
@@ -352,13 +433,13 @@ def build_parser() -> argparse.ArgumentParser:
         default=5.0,
         help="exact selection budget per failed component and phase, in CP-SAT "
         "deterministic time (about seconds of one core; the same on every machine; "
-        "default 5; 0 keeps the greedy answer)",
+        "0 keeps the greedy answer)",
     )
     r.add_argument("--json", help="also write the summary as JSON here")
     r.add_argument("--save", help="also save the whole reconstruction (.npz) for sr33 view")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     r.set_defaults(func=_cmd_reconstruct)
-    sm = sub.add_parser("sample", help="scan-line samples of a sharp CAD shape")
+    sm = add("sample", "scan-line samples of a sharp CAD shape")
     sm.add_argument("shape", nargs="?", help="shape name (see --list)")
     sm.add_argument("--list", action="store_true", help="list shapes and their parameters")
     sm.add_argument("--param", action="append", default=[], metavar="KEY=VALUE")
@@ -378,21 +459,21 @@ def build_parser() -> argparse.ArgumentParser:
     sm.add_argument("--meta", help="also write the metadata as JSON here")
     sm.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     sm.set_defaults(func=_cmd_sample)
-    va = sub.add_parser("validate", help="topology, defects and fidelity of a mesh")
+    va = add("validate", "topology, defects and fidelity of a mesh")
     va.add_argument("mesh")
     va.add_argument("--truth", help="ground-truth mesh: homeomorphism and Hausdorff distance")
     va.add_argument("--points", help="the input samples: are they all vertices?")
     va.add_argument("--json", help="also write the report as JSON here")
     va.set_defaults(func=_cmd_validate)
-    co = sub.add_parser("conditions", help="measure the paper's sample conditions")
+    co = add("conditions", "measure the paper's sample conditions")
     co.add_argument("points")
     co.add_argument("--truth", required=True, help="ground-truth mesh, much finer than h")
     co.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     co.set_defaults(func=_cmd_conditions)
-    vw = sub.add_parser("view", help="inspect a reconstruction (PyVista window or screenshot)")
+    vw = add("view", "inspect a reconstruction (PyVista window or screenshot)")
     vw.add_argument("input", help="points (reconstructed first), a mesh, or a saved .npz")
     vw.add_argument("--truth", help="ground-truth mesh, drawn translucent")
-    vw.add_argument("-k", type=int, default=33, help="neighbourhood size (default 33)")
+    vw.add_argument("-k", type=int, default=33, help="neighbourhood size")
     vw.add_argument("--screenshot", help="render off-screen to this PNG and exit")
     vw.add_argument("--side-by-side", action="store_true", help="truth in a second view")
     vw.add_argument(
@@ -403,27 +484,59 @@ def build_parser() -> argparse.ArgumentParser:
     vw.add_argument("--show", action="append", help="turn a layer on (repeatable)")
     vw.add_argument("--hide", action="append", help="turn a layer off (repeatable)")
     vw.set_defaults(func=_cmd_view)
-    s = sub.add_parser("stats", help="print topology figures of a mesh")
+    s = add("stats", "print topology figures of a mesh")
     s.add_argument("mesh")
     s.set_defaults(func=_cmd_stats)
     return p
 
 
+def _terminated(signum, frame):
+    # SIGTERM unwinds like an exception: atomic outputs remove their temp file
+    raise SystemExit(128 + signum)
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit code (see ``EXIT_CODES``)."""
+    import signal
+
     args = build_parser().parse_args(argv)
+    verbose = getattr(args, "verbose", False)
     logging.basicConfig(
-        level=logging.DEBUG if args.verbose else logging.WARNING,
+        level=logging.DEBUG if verbose else logging.WARNING,
         format="%(name)s: %(message)s",
     )
     logging.getLogger("numba").setLevel(logging.WARNING)
     try:
-        return args.func(args)
+        previous = signal.signal(signal.SIGTERM, _terminated)
+    except ValueError:  # not the main thread: leave signals alone
+        previous = None
+    try:
+        code = args.func(args)
+        sys.stdout.flush()  # a closed pipe shows here, not at exit
+        return code
     except InputError as exc:
         print(f"sr33: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("sr33: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of stdout went away (| head)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 0
+    except Exception as exc:  # noqa: BLE001 - the documented exit code 3
+        if verbose:
+            import traceback
+
+            traceback.print_exc()
+        print(
+            f"sr33: internal error: {type(exc).__name__}: {exc} (run with -v for the traceback)",
+            file=sys.stderr,
+        )
+        return 3
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

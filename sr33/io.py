@@ -163,10 +163,17 @@ def _read_vtp(p: Path):
     return v, f
 
 
-@contextmanager
-def atomic_output(path, formats: tuple[str, ...], what: str) -> Iterator[tuple[str, str]]:
-    """Yield ``(temporary path, extension)`` in the target's directory; on
-    success rename it over ``path``, on any failure remove it."""
+POINT_FORMATS = (".ply", ".xyz", ".txt", ".npy", ".obj", ".vtp")
+TEXT_FORMATS = (".json", ".txt")
+
+
+def check_output(path, formats: tuple[str, ...], what: str) -> Path:
+    """Raise :class:`WriteError` unless ``path`` can be written as one of
+    ``formats`` (extension, existing writable directory, not a directory).
+
+    Called before any long computation, so that a bad output path fails in
+    a second, not after the work (and by :func:`atomic_output` itself).
+    """
     p = Path(path)
     ext = p.suffix.lower()
     if ext not in formats:
@@ -178,6 +185,19 @@ def atomic_output(path, formats: tuple[str, ...], what: str) -> Iterator[tuple[s
         raise WriteError(f"{p}: directory {parent} does not exist")
     if p.is_dir():
         raise WriteError(f"{p}: is a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise WriteError(f"{p}: directory {parent} is not writable")
+    return p
+
+
+@contextmanager
+def atomic_output(path, formats: tuple[str, ...], what: str) -> Iterator[tuple[str, str]]:
+    """Yield ``(temporary path, extension)`` in the target's directory; on
+    success rename it over ``path``, on any failure (or a signal turned into
+    ``SystemExit`` by the command line) remove it."""
+    p = check_output(path, formats, what)
+    ext = p.suffix.lower()
+    parent = p.parent if str(p.parent) else Path(".")
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}.", suffix=ext, dir=parent)
     except OSError as exc:
@@ -247,8 +267,7 @@ def write_points(path, points: np.ndarray, fields: dict[str, np.ndarray] | None 
     """
     v = np.ascontiguousarray(points, dtype=np.float64)
     fields = {k: np.asarray(a, dtype=np.int32) for k, a in (fields or {}).items()}
-    formats = (".ply", ".xyz", ".txt", ".npy", ".obj", ".vtp")
-    with atomic_output(path, formats, "point") as (tmp, ext):
+    with atomic_output(path, POINT_FORMATS, "point") as (tmp, ext):
         if ext == ".ply":
             _write_ply(tmp, v, None, fields)
         elif ext in (".xyz", ".txt"):
@@ -270,7 +289,7 @@ def write_points(path, points: np.ndarray, fields: dict[str, np.ndarray] | None 
 
 def write_text(path, text: str) -> Path:
     """Write a JSON or text file atomically."""
-    with atomic_output(path, (".json", ".txt"), "text") as (tmp, _):
+    with atomic_output(path, TEXT_FORMATS, "text") as (tmp, _):
         with open(tmp, "w", encoding="utf-8") as fh:
             fh.write(text)
     return Path(path)

@@ -98,22 +98,37 @@ class Reconstruction:
     k: int = 33
 
 
-def _canonical_order(uniq, first, inverse):
-    """Order the distinct samples lexicographically by coordinates quantized to
-    1e-9 of the bounding-box diagonal (exact order breaks the remaining ties).
+def normalized(points: np.ndarray) -> np.ndarray:
+    """The samples moved and scaled into the frame every step works in.
+
+    Scaled by the power of two nearest the bounding box's half-extent (exact:
+    only the exponent changes, so neither 1e300 nor 1e-300 overflows or
+    underflows a squared distance) and translated so that the
+    lexicographically smallest sample is the origin.  A subtraction of two
+    nearby doubles is exact, so points given with a large offset (a
+    georeferenced scan) and the same points with the offset taken off give
+    the same working coordinates, bit for bit, and the same result.
+    """
+    half = (0.5 * points.max(axis=0) - 0.5 * points.min(axis=0)).max()
+    e = int(np.frexp(half)[1]) if half > 0 else 0
+    scaled = np.ldexp(points, -e)
+    return scaled - scaled[np.lexsort(points.T[::-1])[0]]
+
+
+def _canonical_order(work: np.ndarray) -> np.ndarray:
+    """The order of the (normalized) samples: lexicographic by coordinates
+    quantized to 1e-9 of the bounding-box diagonal (exact order breaks the
+    remaining ties).
 
     Exact lexicographic order is permutation invariant but not translation
     invariant: adding 1 to coordinates that differ by less than an ulp makes
     them equal and reorders the points.  Quantized keys are the same after a
     translation or scaling (up to values within rounding of a bucket edge).
     """
-    lo = uniq.min(axis=0)
-    size = float(np.linalg.norm(uniq.max(axis=0) - lo)) or 1.0
-    q = np.round((uniq - lo) / (size * 1e-9)).astype(np.int64)
-    order = np.lexsort((q[:, 2], q[:, 1], q[:, 0]))
-    back = np.empty_like(order)
-    back[order] = np.arange(order.shape[0])
-    return uniq[order], first[order], back[inverse]
+    lo = work.min(axis=0)
+    size = float(np.linalg.norm(work.max(axis=0) - lo)) or 1.0
+    q = np.round((work - lo) / (size * 1e-9)).astype(np.int64)
+    return np.lexsort((work[:, 2], work[:, 1], work[:, 0], q[:, 2], q[:, 1], q[:, 0]))
 
 
 @dataclass(frozen=True)
@@ -346,13 +361,20 @@ def reconstruct(
     with timed("prepare", timings):
         uniq, first, inverse = np.unique(raw, axis=0, return_index=True, return_inverse=True)
         inverse = inverse.reshape(-1)
-        uniq, first, inverse = _canonical_order(uniq, first, inverse)
-        check_not_degenerate(uniq)
+        work = normalized(uniq)
+        order = _canonical_order(work)
+        uniq, work, first = uniq[order], work[order], first[order]
+        back = np.empty_like(order)
+        back[order] = np.arange(order.shape[0])
+        inverse = back[inverse]
+        check_not_degenerate(work)
         k = check_k(k, uniq.shape[0])
         dup = raw.shape[0] - uniq.shape[0]
         if dup:
             log.info("merged %d exact duplicate points", dup)
-    pts = uniq  # canonical order (see _canonical_order)
+    # every step works in the normalized frame (see normalized), in canonical
+    # order (see _canonical_order); the output keeps the input's coordinates
+    pts = work
     with timed("localized_rng", timings):
         rng = localized_rng(pts, k, tolerance=tolerance, quiet=quiet)
     with timed("isometric_cycles", timings):
@@ -403,7 +425,7 @@ def reconstruct(
     open_edges = np.sort(relabel[still_open], axis=1) if still_open.size else still_open
     faces = CycleSet(offsets=faces.offsets, vertices=relabel[faces.vertices])
     return Reconstruction(
-        vertices=pts[out_order],
+        vertices=uniq[out_order],
         triangles=relabel[tri],
         input_to_vertex=relabel[inverse],
         duplicates_merged=int(dup),

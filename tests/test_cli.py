@@ -1,5 +1,7 @@
 """The command line: summary table, error lines, exit codes, atomic output."""
 
+import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -257,3 +259,143 @@ def test_validate_exit_codes(cube_xyz, tmp_path, capsys):
 def test_validate_bad_input(tmp_path, capsys):
     msg = error_of(["validate", str(tmp_path / "none.ply")], capsys)
     assert msg.endswith("none.ply: no such file")
+
+
+# --- exit codes, early output checks, signals (issue 22) ----------------------
+
+
+@pytest.fixture
+def crossing_planes_xyz(tmp_path):
+    """Two planes crossing along a line: no surface, the success condition fails."""
+    g = np.linspace(-1, 1, 9)
+    a = [(x, y, 0.0) for x in g for y in g]
+    b = [(x, 0.0, z) for x in g for z in g if z != 0]
+    p = tmp_path / "cross.xyz"
+    np.savetxt(p, np.array(a + b))
+    return p
+
+
+def test_reconstruct_exits_1_when_the_success_condition_fails(
+    crossing_planes_xyz, tmp_path, capsys
+):
+    out = tmp_path / "cross.ply"
+    code, text, _ = run(
+        ["reconstruct", str(crossing_planes_xyz), "-k", "12", "-o", str(out), "-q"], capsys
+    )
+    assert code == 1
+    assert re.search(r"^success condition +NOT met$", text, re.M)
+    assert out.exists()  # the result is still written
+
+
+def test_outputs_are_checked_before_the_work(cube_xyz, tmp_path, capsys, monkeypatch):
+    import importlib
+
+    def boom(*a, **k):
+        raise AssertionError("the reconstruction ran before the outputs were checked")
+
+    monkeypatch.setattr(importlib.import_module("sr33.reconstruct"), "reconstruct", boom)
+    good = str(tmp_path / "ok.ply")
+    cases = [
+        (["-o", str(tmp_path / "out.xyz2")], "unsupported output format .xyz2"),
+        (["-o", good, "--json", str(tmp_path / "no" / "s.json")], "does not exist"),
+        (["-o", good, "--save", str(tmp_path / "s.txt")], "unsupported reconstruction format"),
+        (["-o", str(cube_xyz)], "unsupported output format .xyz"),
+    ]
+    for extra, text in cases:
+        msg = error_of(["reconstruct", str(cube_xyz), "-q"] + extra, capsys)
+        assert text in msg, msg
+    from sr33.io import write_points
+
+    ply = tmp_path / "points.ply"
+    write_points(ply, cube_lattice(4))
+    before = ply.read_bytes()
+    msg = error_of(["reconstruct", str(ply), "-o", str(ply), "-q"], capsys)
+    assert "is also the input" in msg
+    assert ply.read_bytes() == before  # the input is never overwritten
+    assert not (tmp_path / "ok.ply").exists()
+
+
+def test_sample_refuses_the_same_path_for_points_and_truth(tmp_path, capsys):
+    pytest.importorskip("cadquery")
+    x = str(tmp_path / "x.ply")
+    msg = error_of(["sample", "cube", "-o", x, "--truth", x, "-q"], capsys)
+    assert "is also the point file" in msg
+    assert not Path(x).exists()
+
+
+def test_internal_errors_exit_3_with_one_line(cube_xyz, tmp_path, capsys, monkeypatch):
+    import importlib
+
+    def broken(*a, **k):
+        raise RuntimeError("kernel exploded")
+
+    monkeypatch.setattr(importlib.import_module("sr33.reconstruct"), "reconstruct", broken)
+    argv = ["reconstruct", str(cube_xyz), "-o", str(tmp_path / "o.ply"), "-q"]
+    code, _, err = run(argv, capsys)
+    assert code == 3
+    assert err.strip().splitlines() == [
+        "sr33: internal error: RuntimeError: kernel exploded (run with -v for the traceback)"
+    ]
+    code, _, err = run(argv + ["-v"], capsys)  # -v after the subcommand
+    assert code == 3 and "Traceback (most recent call last)" in err
+
+
+def test_version_and_defaults_in_help(capsys):
+    from sr33 import __version__
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0 and capsys.readouterr().out.strip() == f"sr33 {__version__}"
+    with pytest.raises(SystemExit):
+        main(["reconstruct", "--help"])
+    out = capsys.readouterr().out
+    assert "(default: 33)" in out and "(default: 20000)" in out
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    assert "2  bad input or output" in capsys.readouterr().out
+
+
+def test_a_closed_pipe_is_not_an_error(cube_xyz, tmp_path, capsys, monkeypatch):
+    mesh = tmp_path / "c.ply"
+    assert main(["reconstruct", str(cube_xyz), "-k", "12", "-o", str(mesh), "-q"]) == 0
+    capsys.readouterr()
+
+    class ClosedPipe:
+        def write(self, s):
+            return len(s)
+
+        def flush(self):
+            raise BrokenPipeError(32, "Broken pipe")
+
+        def fileno(self):
+            return os.open(os.devnull, os.O_WRONLY)
+
+    monkeypatch.setattr(sys, "stdout", ClosedPipe())
+    assert main(["stats", str(mesh)]) == 0
+    assert "Traceback" not in capsys.readouterr().err
+
+
+def test_sigterm_during_a_write_leaves_no_temporary_file(cube_xyz, tmp_path):
+    import signal
+    import time
+
+    out = tmp_path / "out" / "mesh.obj"
+    out.parent.mkdir()
+    code = f"""
+import time, numpy as np, sys
+real = np.savetxt
+def slow(*a, **k):
+    real(*a, **k)
+    time.sleep(60)
+np.savetxt = slow
+from sr33.cli import main
+sys.exit(main(["reconstruct", {str(cube_xyz)!r}, "-k", "12", "-o", {str(out)!r}, "-q"]))
+"""
+    proc = subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and not list(out.parent.iterdir()):
+        time.sleep(0.1)
+    assert list(out.parent.iterdir()), "the write never started"
+    proc.send_signal(signal.SIGTERM)
+    assert proc.wait(timeout=60) == 128 + signal.SIGTERM
+    assert list(out.parent.iterdir()) == []
