@@ -251,3 +251,34 @@ def test_edges_plainly_not_delaunay_are_flipped(height, crossings, flipped):
     assert len(got) == 5
     want = [[0, 2, 3], [1, 2, 3]] if flipped else [[0, 1, 2], [0, 1, 3]]
     assert sorted(t.tolist()) == want
+
+
+def test_conditions_command_exits_1_when_a_condition_fails(plane, tmp_path, capsys):
+    # an equilateral lattice stretched 2x along x: its Delaunay triangles
+    # have a short edge far below sqrt(3)/2 of the longest -> III-ii fails
+    from sr33.cli import main
+    from sr33.io import write_mesh, write_points
+
+    xs = np.arange(-0.45, 0.451, 0.05)
+    ys = np.arange(-0.45, 0.451, 0.1)
+    p = np.stack(np.meshgrid(xs, ys, [0.0]), -1).reshape(-1, 3)
+    p[:, 0] += np.random.default_rng(0).normal(0, 1e-4, len(p))
+    write_points(tmp_path / "p.xyz", p)
+    write_mesh(tmp_path / "t.ply", *plane)
+    code = main(["conditions", str(tmp_path / "p.xyz"), "--truth", str(tmp_path / "t.ply"), "-q"])
+    out = capsys.readouterr().out
+    assert "FAIL" in out
+    assert code == 1
+
+
+def test_validate_exits_1_when_input_points_are_not_vertices(tmp_path, capsys):
+    from sr33.cli import main
+    from sr33.io import write_mesh, write_points
+
+    tetra = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    write_mesh(tmp_path / "m.ply", tetra, np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]]))
+    write_points(tmp_path / "p.xyz", np.vstack([tetra, [[0.2, 0.2, 0.2]]]))
+    assert main(["validate", str(tmp_path / "m.ply")]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(tmp_path / "m.ply"), "--points", str(tmp_path / "p.xyz")]) == 1
+    assert "input points not vertices  1" in capsys.readouterr().out

@@ -53,8 +53,10 @@ def test_translation_invariance_to_offsets_of_1e7_times_the_size(shift):
     assert triangle_set(b.triangles) == triangle_set(a.triangles)
 
 
-@pytest.mark.parametrize("scale", [1e300, 1e200, 1e-300, 1e150, 1e-150])
-def test_extreme_magnitudes_give_the_unit_result(scale):
+SCALES = (1e300, 1e200, 1e-300, 1e150, 1e-150)
+
+
+def test_extreme_magnitudes_give_the_unit_result():
     # the cube x 1e300 or x 1e-300 once never finished (squared distances
     # overflowed or underflowed in the localized RNG); spot x 1e+-150 came
     # out with 54 open edges.  A hang fails the subprocess's timeout.
@@ -65,12 +67,15 @@ def test_extreme_magnitudes_give_the_unit_result(scale):
         from sr33.samplers import cube_lattice
         p = cube_lattice(6) / 6.0
         a = reconstruct(p, 33).triangles
-        b = reconstruct(p * {scale!r}, 33).triangles
-        print(int(np.array_equal(a, b)), len(b))
+        for scale in {SCALES!r}:
+            b = reconstruct(p * scale, 33).triangles
+            print(scale, int(np.array_equal(a, b)), len(b))
         """
     )
-    same, count = got.split()
-    assert same == "1" and int(count) == 2 * (6 * 36 + 2) - 4
+    rows = [line.split() for line in got.splitlines()]
+    assert [float(r[0]) for r in rows] == list(SCALES)
+    for scale, same, count in rows:
+        assert same == "1" and int(count) == 2 * (6 * 36 + 2) - 4, scale
 
 
 def test_spot_at_extreme_magnitudes_stays_closed():
@@ -81,3 +86,26 @@ def test_spot_at_extreme_magnitudes_stays_closed():
         st = mesh_stats(rec.triangles, rec.vertices.shape[0])
         assert st.open_edges == 0 and st.euler == 2
         assert np.array_equal(rec.triangles, ref.triangles)
+
+
+@pytest.mark.parametrize("far", [1e4, 1e8])
+def test_one_outlier_keeps_memory_bounded_and_the_cube_closed(far):
+    # the cube plus one point at (far, 0, 0) once asked for 41.8 GiB (1e4)
+    # and 19.7 PiB (1e8) in the crossing tests' grid
+    got = _in_subprocess(
+        f"""
+        import resource
+        import numpy as np
+        from sr33 import reconstruct
+        from sr33.samplers import cube_lattice
+        from sr33.validators import mesh_stats
+        p = np.vstack([cube_lattice(8) / 8.0, [[{far!r}, 0.0, 0.0]]])
+        r = reconstruct(p, 33)
+        st = mesh_stats(r.triangles, r.vertices.shape[0])
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
+        print(peak, st.used_vertices, st.overloaded_edges)
+        """
+    )
+    peak_kib, used, overloaded = (int(x) for x in got.split())
+    assert peak_kib < 2 * 1024 * 1024, f"peak {peak_kib / 1024:.0f} MiB"
+    assert used == 6 * 64 + 2 + 1 and overloaded == 0
