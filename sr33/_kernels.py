@@ -326,16 +326,20 @@ def neighbourhood_disks(
 
 
 @njit(cache=True)
-def _tri_area(p, a, b, c):
+def _corner_cross(p, a, b, c):
+    """(b - a) x (c - a), as a tuple."""
     ux = p[b, 0] - p[a, 0]
     uy = p[b, 1] - p[a, 1]
     uz = p[b, 2] - p[a, 2]
     vx = p[c, 0] - p[a, 0]
     vy = p[c, 1] - p[a, 1]
     vz = p[c, 2] - p[a, 2]
-    cx = uy * vz - uz * vy
-    cy = uz * vx - ux * vz
-    cz = ux * vy - uy * vx
+    return uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+
+
+@njit(cache=True)
+def _tri_area(p, a, b, c):
+    cx, cy, cz = _corner_cross(p, a, b, c)
     return 0.5 * np.sqrt(cx * cx + cy * cy + cz * cz)
 
 
@@ -395,15 +399,7 @@ def min_area_splits(p, allowed, rtol):
 
 @njit(cache=True)
 def _unit_normal(p, a, b, c, out):
-    ux = p[b, 0] - p[a, 0]
-    uy = p[b, 1] - p[a, 1]
-    uz = p[b, 2] - p[a, 2]
-    vx = p[c, 0] - p[a, 0]
-    vy = p[c, 1] - p[a, 1]
-    vz = p[c, 2] - p[a, 2]
-    out[0] = uy * vz - uz * vy
-    out[1] = uz * vx - ux * vz
-    out[2] = ux * vy - uy * vx
+    out[0], out[1], out[2] = _corner_cross(p, a, b, c)
     length = np.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2])
     if length > 0:
         out[0] /= length
