@@ -58,8 +58,12 @@ lock: $(STAMP)
 	$(BIN)/python -m pip freeze --exclude-editable | sort >> constraints.new
 	mv constraints.new constraints.txt
 
+# the deep profile of the fuzz targets (file readers over mutated bytes,
+# messy point arrays; over 10,000 inputs) and of the properties; one file
+# alone: make fuzz FUZZ=tests/test_fuzz.py
+FUZZ ?= tests/test_fuzz.py tests/test_properties.py
 fuzz: $(STAMP)
-	HYPOTHESIS_PROFILE=deep FUZZ_REPORT=1 $(BIN)/python -m pytest -q -p no:cacheprovider tests/test_properties.py
+	HYPOTHESIS_PROFILE=deep FUZZ_REPORT=1 $(BIN)/python -m pytest -q -p no:cacheprovider $(FUZZ)
 
 # the optional comparison (Open3D ball pivoting and Poisson, CGAL advancing
 # front); Open3D's wheel needs the system library libusb-1.0

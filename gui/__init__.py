@@ -7,6 +7,20 @@ if __name__ != "sr33.gui":  # the folder installs as sr33.gui (pyproject.toml)
     raise ImportError(f"this folder is sr33.gui; import it by that name, not {__name__}")
 
 from ._pv import has_display, pyvista  # noqa: E402
-from .inspector import COLOURS, LAYERS, Inspector, InspectorState  # noqa: E402
+from .inspector import (  # noqa: E402
+    COLOURS,
+    LAYERS,
+    Inspector,
+    InspectorState,
+    mesh_as_reconstruction,
+)
 
-__all__ = ["COLOURS", "LAYERS", "Inspector", "InspectorState", "has_display", "pyvista"]
+__all__ = [
+    "COLOURS",
+    "LAYERS",
+    "Inspector",
+    "InspectorState",
+    "has_display",
+    "mesh_as_reconstruction",
+    "pyvista",
+]

@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from sr33.cycles import trivial_isometric_cycles
+from sr33.cycles import CycleSet, trivial_isometric_cycles
+from sr33.mesh import as_mesh
 from sr33.reconstruct import Reconstruction, reconstruct
 from sr33.rng import k_neighbourhoods
 from sr33.validators.conditions import local_delaunay
@@ -110,6 +111,48 @@ def _polylines(points: np.ndarray, cycles, pv):
     return pv.PolyData(points, lines=flat)
 
 
+def mesh_as_reconstruction(vertices, triangles) -> Reconstruction:
+    """A mesh (a file given to ``sr33 view``) as a :class:`Reconstruction`
+    the inspector can show: its own triangles as the face cycles, no RNG,
+    ``k = 0`` (none was used, and the panel says so).
+
+    ``success`` is the paper's success condition (Section 4) measured on
+    the mesh itself, not assumed: every edge in exactly two triangles, every
+    vertex link one disk, every vertex used; ``open_edges`` are its edges in
+    one triangle.
+
+    Examples
+    --------
+    >>> v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    >>> tetra = [(0, 2, 1), (0, 1, 3), (1, 2, 3), (2, 0, 3)]
+    >>> mesh_as_reconstruction(v, tetra).success, mesh_as_reconstruction(v, tetra[1:]).success
+    (True, False)
+    """
+    v, f = as_mesh(vertices, triangles)
+    n = v.shape[0]
+    edges, counts = edge_uses(f)
+    sig = signature(f, n)
+    closed = bool((counts == 2).all()) and sig.manifold and not sig.unused_points
+    return Reconstruction(
+        vertices=v,
+        triangles=f,
+        input_to_vertex=np.arange(n),
+        duplicates_merged=0,
+        rng_edges=np.empty((0, 2), dtype=np.int64),
+        candidate_cycles=0,
+        face_cycles=CycleSet(np.arange(0, 3 * f.shape[0] + 1, 3), f.ravel().astype(np.int64)),
+        success=closed,
+        orientable=all(c.orientable for c in sig.components),
+        open_edges=edges[counts == 1],
+        unresolved_samples=np.empty(0, dtype=np.int64),
+        non_disk_neighbourhoods=np.empty(0, dtype=np.int64),
+        coned_samples=np.empty(0, dtype=np.int64),
+        fallback_components=0,
+        timings={},
+        k=0,
+    )
+
+
 class Inspector:
     """Interactive inspector of one reconstruction (see the module docstring).
 
@@ -154,7 +197,8 @@ class Inspector:
         self.rec: Reconstruction = (
             reconstruction if reconstruction is not None else (reconstruct(self.points, int(k)))
         )
-        self.state.k = int(self.rec.k)
+        # a mesh shown as read (k 0) keeps the slider's k for a re-run
+        self.state.k = int(self.rec.k) if self.rec.k else int(k)
         self._actors: dict[str, list] = {}
         self._slider = None
         self._pick_actors: list = []
@@ -189,6 +233,7 @@ class Inspector:
             unused_samples=int(self.unused.shape[0]),
             condition_violations=int(self.conditions.shape[0]),
             success=bool(rec.success),
+            reconstructed=bool(rec.k),
         )
         self.state.figures = st
 
@@ -283,13 +328,21 @@ class Inspector:
 
     def _panel(self, extra: str = ""):
         f = self.state.figures
+        if f.get("reconstructed", True):
+            head = f"k = {self.state.k}   "
+            verdict = "success condition " + ("met" if f.get("success") else "NOT met")
+        else:  # a mesh file shown as it is: no k was used, the verdict is the mesh's own
+            head = "mesh as read (no k used)   "
+            verdict = "closed 2-manifold, every sample a vertex: " + (
+                "yes" if f.get("success") else "NO"
+            )
         lines = [
-            f"k = {self.state.k}   points {f.get('points')}   faces {f.get('faces')}",
+            head + f"points {f.get('points')}   faces {f.get('faces')}",
             f"open {f.get('open_edges')}  overloaded {f.get('overloaded_edges')}  "
             f"Euler {f.get('euler')}  components {f.get('components')}",
             f"non-manifold {f.get('nonmanifold_vertices')}  unused {f.get('unused_samples')}  "
             f"condition III violations {f.get('condition_violations')}",
-            "success condition " + ("met" if f.get("success") else "NOT met"),
+            verdict,
         ]
         if self.state.message:
             lines.append(self.state.message)

@@ -156,8 +156,8 @@ def _check_args(spacing, target_points, ratio, jitter, dropout, seed, directions
         raise SamplingError(f"jitter must be a finite number >= 0, got {jitter!r}")
     if not (isinstance(dropout, (int, float)) and 0 <= dropout < 1):
         raise SamplingError(f"dropout must be within [0, 1), got {dropout!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-        raise SamplingError(f"seed must be an integer, got {seed!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise SamplingError(f"seed must be an integer >= 0, got {seed!r}")
     dirs = np.asarray(AXES if directions is None else directions, dtype=float)
     if dirs.ndim != 2 or dirs.shape[1] != 3 or dirs.shape[0] < 1:
         raise SamplingError(f"directions must have shape (d, 3), got {dirs.shape}")

@@ -640,6 +640,9 @@ def describe(name: str) -> str:
     return _spec(name).description
 
 
+PARAM_RANGE = (1e-4, 1e6)  # magnitudes OpenCascade's 1e-7 precision models faithfully
+
+
 def _resolve(name: str, params: dict[str, Any]) -> dict[str, float]:
     spec = _spec(name)
     unknown = sorted(set(params) - set(spec.defaults))
@@ -655,6 +658,12 @@ def _resolve(name: str, params: dict[str, Any]) -> dict[str, float]:
             raise ShapeError(f"{key} must be a number, got {value!r}")
         if not math.isfinite(float(value)):
             raise ShapeError(f"{key} must be finite, got {value!r}")
+        if not (value == 0 or PARAM_RANGE[0] <= abs(float(value)) <= PARAM_RANGE[1]):
+            raise ShapeError(
+                f"{key} must be 0 or of magnitude {_fmt(PARAM_RANGE[0])} to "
+                f"{_fmt(PARAM_RANGE[1])}, got {value!r} (OpenCascade models to an absolute "
+                "precision of 1e-7: build at unit scale and scale the samples)"
+            )
         out[key] = float(value)
     spec.check(out)
     return out
@@ -913,7 +922,13 @@ def build(name: str, **params: float) -> Shape:
         whose tessellation does not fit its B-rep topology.
     """
     p = _resolve(name, params)
-    solid = _SPECS[name].make(p)
+    try:
+        solid = _SPECS[name].make(p)
+    except ImportError:
+        raise  # CadQuery missing: the caller says which extra to install
+    except Exception as exc:  # OCP raises Standard_Failure and its kin
+        msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ShapeError(f"CadQuery could not build {name} for {p}: {msg}") from None
     from OCP.BRepCheck import BRepCheck_Analyzer
 
     if not BRepCheck_Analyzer(solid.wrapped).IsValid():

@@ -145,10 +145,7 @@ def _parse_params(items: list[str]) -> dict[str, float]:
 
 
 def _cmd_sample(args) -> int:
-    try:
-        from sr33.samplers import scanline, shapes
-    except ImportError as exc:  # pragma: no cover - depends on the install
-        raise InputError(f"sampling needs CadQuery: pip install cadquery ({exc})") from None
+    from sr33.samplers import scanline, shapes  # CadQuery is imported on use
 
     if args.list:
         for name in shapes.shape_names():
@@ -307,7 +304,7 @@ def _cmd_conditions(args) -> int:
 
 
 def _cmd_view(args) -> int:
-    from sr33.gui import has_display, pyvista
+    from sr33.gui import has_display, mesh_as_reconstruction, pyvista
 
     from .io import load_reconstruction, read_mesh
 
@@ -330,11 +327,7 @@ def _cmd_view(args) -> int:
         if f.shape[0]:
             from .reconstruct import reconstruct
 
-            rec = (
-                reconstruct(v, args.k)
-                if args.reconstruct
-                else _mesh_as_reconstruction(v, f, args.k)
-            )
+            rec = reconstruct(v, args.k) if args.reconstruct else mesh_as_reconstruction(v, f)
     truth = read_mesh(args.truth) if args.truth else None
     if truth is not None and truth[1].shape[0] == 0:
         raise InputError(f"{args.truth}: has no faces; the truth must be a triangle mesh")
@@ -344,10 +337,13 @@ def _cmd_view(args) -> int:
     ins = Inspector(
         plotter, points, k=args.k, truth=truth, reconstruction=rec, widgets=not args.screenshot
     )
-    for layer in args.show or []:
-        ins.set_layer(layer, True)
-    for layer in args.hide or []:
-        ins.set_layer(layer, False)
+    try:
+        for layer in args.show or []:
+            ins.set_layer(layer, True)
+        for layer in args.hide or []:
+            ins.set_layer(layer, False)
+    except ValueError as exc:
+        raise InputError(f"--show/--hide: {exc}") from None
     if args.screenshot:
         from .io import atomic_output
 
@@ -359,32 +355,14 @@ def _cmd_view(args) -> int:
     return 0
 
 
-def _mesh_as_reconstruction(v, f, k):
-    """A mesh file shown as it is (its own faces, no RNG or cycles)."""
-    import numpy as np
-
-    from .cycles import CycleSet
-    from .reconstruct import Reconstruction
-
-    n = v.shape[0]
-    return Reconstruction(
-        vertices=v,
-        triangles=f,
-        input_to_vertex=np.arange(n),
-        duplicates_merged=0,
-        rng_edges=np.empty((0, 2), dtype=np.int64),
-        candidate_cycles=0,
-        face_cycles=CycleSet(np.arange(0, 3 * f.shape[0] + 1, 3), f.ravel().astype(np.int64)),
-        success=True,
-        orientable=True,
-        open_edges=np.empty((0, 2), dtype=np.int64),
-        unresolved_samples=np.empty(0, dtype=np.int64),
-        non_disk_neighbourhoods=np.empty(0, dtype=np.int64),
-        coned_samples=np.empty(0, dtype=np.int64),
-        fallback_components=0,
-        timings={},
-        k=k,
-    )
+# optional packages: module -> (extra that installs it, what it is for)
+OPTIONAL = {
+    "cadquery": ("cad", "CadQuery for the CAD shapes"),
+    "OCP": ("cad", "CadQuery's OpenCascade for the CAD shapes"),
+    "pyvista": ("vtk", "PyVista for rendering, .vtp files and surface distances"),
+    "vtk": ("vtk", "VTK (through PyVista)"),
+    "potpourri3d": ("validate", "potpourri3d for geodesics on the truth"),
+}
 
 
 class _DefaultsShown(argparse.ArgumentDefaultsHelpFormatter):
@@ -516,6 +494,17 @@ def main(argv: list[str] | None = None) -> int:
         return code
     except InputError as exc:
         print(f"sr33: error: {exc}", file=sys.stderr)
+        return 2
+    except ImportError as exc:
+        root = (exc.name or "").split(".")[0]
+        if root not in OPTIONAL:
+            raise
+        extra, what = OPTIONAL[root]
+        print(
+            f"sr33: error: {args.command} needs {what} ({root} is not installed): "
+            f"pip install 'sr33[{extra}]'",
+            file=sys.stderr,
+        )
         return 2
     except KeyboardInterrupt:
         print("sr33: interrupted", file=sys.stderr)

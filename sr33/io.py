@@ -2,7 +2,8 @@
 
 Point lists: ``.xyz``/``.txt`` (whitespace or comma separated, first three
 columns), ``.npy`` ((n, 3) array), ``.obj`` (``v`` lines; faces ignored).
-Meshes: ``.ply``, ``.off``, ``.stl``, ``.obj`` through meshio, ``.vtp``
+Meshes: ``.ply`` and ``.stl`` through meshio (PLY element counts checked
+against the header), ``.obj`` and ``.off`` by own readers, ``.vtp``
 through PyVista (optional extra ``vtk``); as inputs their vertices are the
 samples.  Every failure becomes :class:`ReadError` / :class:`WriteError`
 with the path and the reason; outputs go to a temporary file in the target
@@ -11,18 +12,20 @@ directory that is renamed into place, so a failed write leaves nothing.
 
 from __future__ import annotations
 
+import io
 import os
 import tempfile
 import warnings
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, redirect_stderr, redirect_stdout
 from pathlib import Path
 
 import numpy as np
 
 from ._validate import InputError
+from .mesh import as_mesh
 
-POINT_FORMATS = (".xyz", ".txt", ".npy")
+POINT_LISTS = (".xyz", ".txt", ".npy")
 MESH_FORMATS = (".ply", ".obj", ".off", ".stl", ".vtp")
 
 
@@ -37,7 +40,9 @@ class WriteError(InputError):
 def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
     verts: list[list[float]] = []
     faces: list[list[int]] = []
-    with open(path, encoding="utf-8", errors="strict") as fh:
+    # utf-8-sig: a byte-order mark (Windows editors write one) is not part
+    # of the first line
+    with open(path, encoding="utf-8-sig", errors="strict") as fh:
         for lineno, line in enumerate(fh, 1):
             parts = line.split()
             if not parts:
@@ -64,9 +69,53 @@ def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
     return v, f
 
 
+def _read_off(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """OFF (optionally ``COFF``/``NOFF``...: extra per-vertex values ignored):
+    the counts line is checked against the vertex and face lines present."""
+    with open(path, encoding="utf-8-sig", errors="strict") as fh:
+        lines = [(i, ln.split("#", 1)[0].split()) for i, ln in enumerate(fh, 1)]
+    lines = [(i, parts) for i, parts in lines if parts]
+    if not lines or not lines[0][1][0].endswith("OFF"):
+        raise ReadError(f"{path}: not an OFF file (the first line must be OFF)")
+    head = lines[0][1][1:]
+    rest = lines[1:]
+    if not head:
+        if not rest:
+            raise ReadError(f"{path}: OFF file has no counts line")
+        head, rest = rest[0][1], rest[1:]
+    try:
+        nv, nf = int(head[0]), int(head[1])
+    except (ValueError, IndexError):
+        raise ReadError(f"{path}: OFF counts line must hold the vertex and face counts") from None
+    if nv < 0 or nf < 0:
+        raise ReadError(f"{path}: OFF counts must not be negative, got {nv} {nf}")
+    if len(rest) < nv + nf:
+        raise ReadError(
+            f"{path}: truncated OFF: it declares {nv} vertices and {nf} faces, "
+            f"the file holds {len(rest)} data lines"
+        )
+    verts = np.empty((nv, 3), dtype=np.float64)
+    for row, (lineno, parts) in enumerate(rest[:nv]):
+        try:
+            verts[row] = [float(x) for x in parts[:3]]
+        except ValueError:
+            raise ReadError(f"{path}: line {lineno}: bad vertex coordinates") from None
+    faces: list[list[int]] = []
+    for lineno, parts in rest[nv : nv + nf]:
+        try:
+            m = int(parts[0])
+            idx = [int(x) for x in parts[1 : 1 + m]]
+        except ValueError:
+            raise ReadError(f"{path}: line {lineno}: bad face indices") from None
+        if m < 3 or len(idx) != m:
+            raise ReadError(f"{path}: line {lineno}: a face needs at least 3 vertex indices")
+        faces.extend([idx[0], idx[j], idx[j + 1]] for j in range(1, m - 1))
+    return verts, np.array(faces, dtype=np.int64).reshape(-1, 3)
+
+
 def _read_text_points(path: Path) -> np.ndarray:
     rows = []
-    with open(path, encoding="utf-8") as fh:
+    with open(path, encoding="utf-8-sig") as fh:
         for lineno, line in enumerate(fh, 1):
             s = line.strip()
             if not s or s.startswith("#"):
@@ -89,10 +138,10 @@ def read_mesh(path) -> tuple[np.ndarray, np.ndarray]:
     """
     p = Path(path)
     ext = p.suffix.lower()
-    if ext not in POINT_FORMATS + MESH_FORMATS:
+    if ext not in POINT_LISTS + MESH_FORMATS:
         raise ReadError(
             f"{p}: unsupported format {ext or '(none)'}; "
-            f"use one of {', '.join(POINT_FORMATS + MESH_FORMATS)}"
+            f"use one of {', '.join(POINT_LISTS + MESH_FORMATS)}"
         )
     if not p.exists():
         raise ReadError(f"{p}: no such file")
@@ -104,6 +153,8 @@ def read_mesh(path) -> tuple[np.ndarray, np.ndarray]:
     try:
         if ext == ".obj":
             v, f = _read_obj(p)
+        elif ext == ".off":
+            v, f = _read_off(p)
         elif ext in (".xyz", ".txt"):
             v, f = _read_text_points(p), empty_tri
         elif ext == ".npy":
@@ -116,10 +167,18 @@ def read_mesh(path) -> tuple[np.ndarray, np.ndarray]:
         else:
             import meshio
 
-            with warnings.catch_warnings():
+            declared = _ply_counts(p) if ext == ".ply" else None
+            with (
+                warnings.catch_warnings(),
+                redirect_stdout(io.StringIO()),
+                redirect_stderr(io.StringIO()),
+            ):
                 # meshio's STL reader overflows a uint32 size check (harmless)
                 warnings.simplefilter("ignore", RuntimeWarning)
-                m = meshio.read(p)
+                try:
+                    m = meshio.read(p, file_format=ext[1:])
+                except SystemExit:  # some meshio readers exit on a bad file
+                    raise ReadError(f"{p}: not a valid {ext} file") from None
             v = np.asarray(m.points, dtype=np.float64)
             if v.ndim != 2 or v.shape[1] < 3:
                 raise ReadError(f"{p}: vertices must be 3D")
@@ -131,6 +190,9 @@ def read_mesh(path) -> tuple[np.ndarray, np.ndarray]:
                     for j in range(1, d.shape[1] - 1):
                         tris.append(d[:, [0, j, j + 1]])
             f = np.concatenate(tris).astype(np.int64) if tris else empty_tri
+            if declared is not None:
+                polygons = sum(len(c.data) for c in m.cells if c.type not in ("vertex", "line"))
+                _check_counts(p, declared, v.shape[0], polygons)
     except InputError:
         raise
     except UnicodeDecodeError:
@@ -140,7 +202,88 @@ def read_mesh(path) -> tuple[np.ndarray, np.ndarray]:
         raise ReadError(f"{p}: unreadable or truncated {ext} file ({msg})") from None
     if v.shape[0] == 0:
         raise ReadError(f"{p}: contains no points")
-    return v, f
+    try:
+        return as_mesh(v, f, name=str(p), item="point" if ext in POINT_LISTS else "vertex")
+    except ValueError as exc:
+        raise ReadError(str(exc)) from None
+
+
+_PLY_SIZES = {
+    **dict.fromkeys(("char", "int8", "uchar", "uint8"), 1),
+    **dict.fromkeys(("short", "int16", "ushort", "uint16"), 2),
+    **dict.fromkeys(("int", "int32", "uint", "uint32", "float", "float32"), 4),
+    **dict.fromkeys(("double", "float64", "int64", "uint64"), 8),
+}
+
+
+def _ply_counts(p: Path) -> dict[str, int]:
+    """The element counts a PLY header declares, checked against the file's
+    size before anything is read (a header that promises 10^12 vertices in a
+    1 kB file is truncated, not a reason to allocate terabytes)."""
+    with open(p, "rb") as fh:
+        head = fh.read(1 << 16)
+    if not head.startswith(b"ply"):
+        raise ReadError(f"{p}: not a PLY file (it does not start with 'ply')")
+    end = head.find(b"end_header")
+    if end < 0:
+        raise ReadError(f"{p}: PLY header has no end_header line (truncated or not PLY)")
+    body = head.find(b"\n", end)
+    body = len(head) if body < 0 else body + 1
+    counts: dict[str, int] = {}
+    min_bytes: dict[str, int] = {}
+    fmt = ""
+    current = None
+    for line in head[:end].decode("ascii", errors="replace").splitlines():
+        parts = line.split()
+        if len(parts) >= 2 and parts[0] == "format":
+            fmt = parts[1]
+        elif len(parts) == 3 and parts[0] == "element":
+            try:
+                counts[parts[1]] = int(parts[2])
+            except ValueError:
+                raise ReadError(f"{p}: PLY element {parts[1]} has count {parts[2]!r}") from None
+            if counts[parts[1]] < 0:
+                raise ReadError(f"{p}: PLY element {parts[1]} has a negative count")
+            current = parts[1]
+            min_bytes[current] = 0
+        elif current is not None and len(parts) >= 3 and parts[0] == "property":
+            # a list needs at least its count; a scalar exactly its size
+            size = _PLY_SIZES.get(parts[2] if parts[1] == "list" else parts[1], 1)
+            min_bytes[current] += size
+    size = p.stat().st_size - body
+    if fmt.startswith("binary"):
+        need = sum(counts[e] * min_bytes[e] for e in counts)
+        if size < need:
+            raise ReadError(
+                f"{p}: truncated PLY: its header declares {_declared(counts)}, "
+                f"which needs at least {need} bytes of data, the file holds {size}"
+            )
+    else:
+        with open(p, "rb") as fh:
+            fh.seek(body)
+            lines = sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 20), b""))
+        # the last line may lack its newline
+        if lines + 1 < sum(counts.values()):
+            raise ReadError(
+                f"{p}: truncated PLY: its header declares {_declared(counts)}, "
+                f"the file holds {lines} data lines"
+            )
+    return counts
+
+
+def _declared(counts: dict[str, int]) -> str:
+    return " and ".join(f"{n} {e}" for e, n in counts.items()) + " elements"
+
+
+def _check_counts(p: Path, declared: dict[str, int], vertices: int, faces: int) -> None:
+    """Raise unless the vertices and faces read are the header's counts."""
+    for what, got in (("vertex", vertices), ("face", faces)):
+        want = declared.get(what, 0)
+        if got != want:
+            raise ReadError(
+                f"{p}: truncated or inconsistent PLY: its header declares {want} "
+                f"{what} elements, {got} were read"
+            )
 
 
 def read_points(path) -> np.ndarray:

@@ -224,6 +224,55 @@ def as_triangles(triangles) -> np.ndarray:
     return tri.astype(np.int64)
 
 
+def as_mesh(
+    vertices, triangles, name: str = "mesh", item: str = "vertex"
+) -> tuple[np.ndarray, np.ndarray]:
+    """A mesh's ``(vertices, triangles)`` checked: float64 ``(n, 3)`` finite
+    vertices and int64 ``(t, 3)`` indices within ``0..n-1``.
+
+    Every mesh given to sr33 (a file read, a validator's argument) passes
+    here, so that a NaN or inf vertex or an index out of range is one
+    :class:`ValueError` naming the first offender, never a crash further on.
+
+    Examples
+    --------
+    >>> as_mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 3]])
+    Traceback (most recent call last):
+    ...
+    ValueError: mesh: triangle 0 uses vertex 3, out of range 0..2
+    """
+    try:
+        v = np.asarray(vertices, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name}: vertices must be numeric ({exc})") from None
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise ValueError(f"{name}: vertices must have shape (n, 3), got {v.shape}")
+    bad = ~np.isfinite(v).all(axis=1)
+    if bad.any():
+        first = int(np.flatnonzero(bad)[0])
+        plural = {"vertex": "vertices"}.get(item, item + "s")
+        raise ValueError(
+            f"{name}: {int(bad.sum())} of {v.shape[0]} {plural} have non-finite (NaN or inf) "
+            f"coordinates, first {item} {first} = {v[first].tolist()}"
+        )
+    tri = np.asarray(triangles)
+    if tri.size and not np.issubdtype(tri.dtype, np.integer):
+        raise ValueError(f"{name}: triangles must be integer indices, got dtype {tri.dtype}")
+    if tri.size == 0:
+        tri = np.empty((0, 3), dtype=np.int64)
+    elif tri.ndim != 2 or tri.shape[1] != 3:
+        raise ValueError(f"{name}: triangles must have shape (t, 3), got {tri.shape}")
+    tri = tri.astype(np.int64)
+    out = (tri < 0) | (tri >= v.shape[0])
+    if out.any():
+        row = int(np.flatnonzero(out.any(axis=1))[0])
+        idx = int(tri[row][out[row]][0])
+        raise ValueError(
+            f"{name}: triangle {row} uses vertex {idx}, out of range 0..{v.shape[0] - 1}"
+        )
+    return np.ascontiguousarray(v), np.ascontiguousarray(tri)
+
+
 def edge_uses(triangles) -> tuple[np.ndarray, np.ndarray]:
     """Distinct undirected edges of triangles (sorted rows) and how many triangles use each.
 
@@ -347,8 +396,9 @@ def closest_points_on_triangles(p, corners) -> tuple[np.ndarray, np.ndarray]:
 
 def surface_points(vertices, triangles, count: int, seed: int = 0) -> np.ndarray:
     """The vertices triangles use plus ``count`` area-uniform random surface points (seeded)."""
-    v = np.asarray(vertices, dtype=np.float64)
-    t = as_triangles(triangles)
+    v, t = as_mesh(vertices, triangles)
+    if t.shape[0] == 0:
+        raise ValueError("mesh: surface points need at least one triangle")
     p = v[t]
     area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
     rng = np.random.default_rng(seed)
@@ -467,8 +517,7 @@ def self_intersections(vertices, triangles, keep=None) -> np.ndarray:
     >>> self_intersections(v, [(0, 1, 2), (3, 4, 5)]).tolist()
     [[0, 1]]
     """
-    v = np.asarray(vertices, dtype=np.float64)
-    t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    v, t = as_mesh(vertices, np.asarray(triangles).reshape(-1, 3))
     if t.shape[0] < 2:
         return np.empty((0, 2), dtype=np.int64)
     p = v[t]

@@ -15,14 +15,15 @@ from scipy import sparse
 from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
-from ._validate import as_points, check_k, check_max_cycle_length, check_not_degenerate
+from ._kernels import compile_notice
+from ._validate import InputError, as_points, check_k, check_max_cycle_length, check_not_degenerate
 from .backtracking import backtracking
 from .cones import attach_cones, ring_centres
 from .cycles import CycleSet, trivial_isometric_cycles
 from .graph import cycle_edges
 from .holes import HoleLoops, concat, crossing_faces, face_links, hole_loops, uncovered, unpinch
 from .mesh import edge_keys, self_intersections
-from .progress import log, timed
+from .progress import Steps, log, notice
 from .rng import localized_rng
 from .selfcheck import check_faces_and_triangles, strict_default
 from .tolerance import DEFAULT, Tolerance
@@ -97,22 +98,70 @@ class Reconstruction:
     timings: dict[str, float] = field(default_factory=dict)
     k: int = 33
 
+    def __repr__(self) -> str:
+        # figures, not arrays: a repr of a 1M-point result must fit a line
+        return (
+            f"Reconstruction(vertices={self.vertices.shape[0]}, "
+            f"triangles={self.triangles.shape[0]}, k={self.k}, success={self.success}, "
+            f"orientable={self.orientable}, open_edges={len(self.open_edges)}, "
+            f"unresolved_samples={len(self.unresolved_samples)}, "
+            f"coned_samples={len(self.coned_samples)}, "
+            f"duplicates_merged={self.duplicates_merged}, "
+            f"fallback_components={self.fallback_components})"
+        )
+
+    def to_pyvista(self):
+        """The surface as a ``pyvista.PolyData`` (needs the ``vtk`` extra).
+
+        For trimesh: ``trimesh.Trimesh(rec.vertices, rec.triangles,
+        process=False)`` (``process=False`` keeps the vertex order, so
+        ``input_to_vertex`` stays valid); for Open3D:
+        ``o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(rec.vertices),
+        o3d.utility.Vector3iVector(rec.triangles))``.
+        """
+        try:
+            import pyvista as pv
+        except ImportError:
+            raise ImportError(
+                "Reconstruction.to_pyvista needs PyVista: pip install 'sr33[vtk]'"
+            ) from None
+        tri = self.triangles.astype(np.int64)
+        faces = np.hstack([np.full((tri.shape[0], 1), 3, dtype=np.int64), tri]).ravel()
+        return pv.PolyData(self.vertices.copy(), faces)
+
+    def to_meshio(self):
+        """The surface as a ``meshio.Mesh`` (one ``triangle`` cell block)."""
+        import meshio
+
+        return meshio.Mesh(self.vertices.copy(), [("triangle", self.triangles.copy())])
+
 
 def normalized(points: np.ndarray) -> np.ndarray:
     """The samples moved and scaled into the frame every step works in.
 
-    Scaled by the power of two nearest the bounding box's half-extent (exact:
-    only the exponent changes, so neither 1e300 nor 1e-300 overflows or
-    underflows a squared distance) and translated so that the
-    lexicographically smallest sample is the origin.  A subtraction of two
-    nearby doubles is exact, so points given with a large offset (a
-    georeferenced scan) and the same points with the offset taken off give
-    the same working coordinates, bit for bit, and the same result.
+    Translated by the bounding box's centre rounded to a multiple of the
+    power of two ``2^(e+1)`` above its extent (0 for samples round the origin,
+    which stay bit for bit as given), then scaled by ``2^-e`` (exact: only
+    the exponent changes, so neither 1e300 nor 1e-300 overflows or
+    underflows a squared distance).  A georeferenced scan at an offset
+    that is a multiple of that power of two (5e5, 4.1e6, 250 for a model a
+    metre across) gives the working coordinates of the same points
+    re-centred, bit for bit (a difference of nearby doubles is exact), and
+    so the same result; any other offset differs by rounding only.
     """
-    half = (0.5 * points.max(axis=0) - 0.5 * points.min(axis=0)).max()
+    half = float((0.5 * points.max(axis=0) - 0.5 * points.min(axis=0)).max())
     e = int(np.frexp(half)[1]) if half > 0 else 0
-    scaled = np.ldexp(points, -e)
-    return scaled - scaled[np.lexsort(points.T[::-1])[0]]
+    centre = 0.5 * points.max(axis=0) + 0.5 * points.min(axis=0)
+    # exponent arithmetic only: 2^(e+1) itself overflows for an extent of 1e308
+    with np.errstate(over="ignore"):
+        shift = np.ldexp(np.round(np.ldexp(centre, -(e + 1))), e + 1)
+        work = np.ldexp(points - np.where(np.isfinite(shift), shift, 0.0), -e)
+    if not np.isfinite(work).all():
+        raise InputError(
+            "points span more than the float64 range allows (an extent near 1.8e308); "
+            "scale them down first"
+        )
+    return work
 
 
 def _canonical_order(work: np.ndarray) -> np.ndarray:
@@ -300,6 +349,94 @@ def _close_holes(
     return best
 
 
+def _compiling(quiet: bool):
+    def notify():
+        notice("compiling the numba kernels (once per install, about 13 s)", quiet)
+
+    return notify
+
+
+def _pipeline(
+    raw,
+    k,
+    run,
+    timings,
+    check,
+    tolerance,
+    max_cycle_length,
+    max_hole_length,
+    budget,
+    exact_seconds,
+    quiet,
+):
+    """Algorithm 1 on validated points, step by step (see :func:`reconstruct`)."""
+    with run.step("prepare", timings):
+        uniq, first, inverse = np.unique(raw, axis=0, return_index=True, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        work = normalized(uniq)
+        order = _canonical_order(work)
+        uniq, work, first = uniq[order], work[order], first[order]
+        back = np.empty_like(order)
+        back[order] = np.arange(order.shape[0])
+        inverse = back[inverse]
+        check_not_degenerate(work)
+        k = check_k(k, uniq.shape[0])
+        dup = raw.shape[0] - uniq.shape[0]
+        if dup:
+            log.info("merged %d exact duplicate points", dup)
+    # every step works in the normalized frame (see normalized), in canonical
+    # order (see _canonical_order); the output keeps the input's coordinates
+    pts = work
+    with run.step("localized_rng", timings):
+        rng = localized_rng(pts, k, tolerance=tolerance, quiet=quiet)
+    with run.step("isometric_cycles", timings):
+        cycles = trivial_isometric_cycles(rng.edges, pts.shape[0], max_length=max_cycle_length)
+    with run.step("backtracking", timings):
+        sel = backtracking(
+            pts,
+            rng.edges,
+            cycles,
+            tolerance=tolerance,
+            k=k,
+            neighbourhoods=rng.neighbourhoods,
+            budget=budget,
+            exact_seconds=exact_seconds,
+            quiet=quiet,
+        )
+    with run.step("triangulate", timings):
+        # a selection the strict search made alone is checked for folds only
+        faces, tr, centres, n_loops, figs = _close_holes(
+            pts, sel.faces, max_hole_length, tolerance, everywhere=sel.fallback_components > 0
+        )
+        tri = tr.triangles
+    if check:
+        with run.step("self_checks", timings):
+            check_faces_and_triangles(faces, tri, tr.face_of_triangle, centres)
+    with run.step("cones", timings):
+        if tri.shape[0]:
+            tri, coned = attach_cones(pts, tri)
+        else:
+            coned = np.empty(0, dtype=np.int64)
+    return (
+        pts,
+        uniq,
+        first,
+        inverse,
+        dup,
+        k,
+        rng,
+        cycles,
+        sel,
+        faces,
+        tr,
+        centres,
+        n_loops,
+        figs,
+        tri,
+        coned,
+    )
+
+
 def reconstruct(
     points,
     k: int = 33,
@@ -358,53 +495,40 @@ def reconstruct(
     raw = as_points(points)
     max_cycle_length = check_max_cycle_length(max_cycle_length)
     timings: dict[str, float] = {}
-    with timed("prepare", timings):
-        uniq, first, inverse = np.unique(raw, axis=0, return_index=True, return_inverse=True)
-        inverse = inverse.reshape(-1)
-        work = normalized(uniq)
-        order = _canonical_order(work)
-        uniq, work, first = uniq[order], work[order], first[order]
-        back = np.empty_like(order)
-        back[order] = np.arange(order.shape[0])
-        inverse = back[inverse]
-        check_not_degenerate(work)
-        k = check_k(k, uniq.shape[0])
-        dup = raw.shape[0] - uniq.shape[0]
-        if dup:
-            log.info("merged %d exact duplicate points", dup)
-    # every step works in the normalized frame (see normalized), in canonical
-    # order (see _canonical_order); the output keeps the input's coordinates
-    pts = work
-    with timed("localized_rng", timings):
-        rng = localized_rng(pts, k, tolerance=tolerance, quiet=quiet)
-    with timed("isometric_cycles", timings):
-        cycles = trivial_isometric_cycles(rng.edges, pts.shape[0], max_length=max_cycle_length)
-    with timed("backtracking", timings):
-        sel = backtracking(
+    check = strict_default() if strict is None else strict
+    names = ["prepare", "localized_rng", "isometric_cycles", "backtracking", "triangulate"]
+    names += ["self_checks"] * check + ["cones"]
+    with Steps(names, quiet) as run, compile_notice(_compiling(quiet)):
+        (
             pts,
-            rng.edges,
+            uniq,
+            first,
+            inverse,
+            dup,
+            k,
+            rng,
             cycles,
-            tolerance=tolerance,
-            k=k,
-            neighbourhoods=rng.neighbourhoods,
-            budget=budget,
-            exact_seconds=exact_seconds,
-            quiet=quiet,
+            sel,
+            faces,
+            tr,
+            centres,
+            n_loops,
+            figs,
+            tri,
+            coned,
+        ) = _pipeline(
+            raw,
+            k,
+            run,
+            timings,
+            check,
+            tolerance,
+            max_cycle_length,
+            max_hole_length,
+            budget,
+            exact_seconds,
+            quiet,
         )
-    with timed("triangulate", timings):
-        # a selection the strict search made alone is checked for folds only
-        faces, tr, centres, n_loops, figs = _close_holes(
-            pts, sel.faces, max_hole_length, tolerance, everywhere=sel.fallback_components > 0
-        )
-        tri = tr.triangles
-    if strict_default() if strict is None else strict:
-        with timed("self_checks", timings):
-            check_faces_and_triangles(faces, tri, tr.face_of_triangle, centres)
-    with timed("cones", timings):
-        if tri.shape[0]:
-            tri, coned = attach_cones(pts, tri)
-        else:
-            coned = np.empty(0, dtype=np.int64)
     # canonical -> output labels (order of first occurrence in the input)
     out_order = np.argsort(first, kind="stable")
     relabel = np.empty_like(out_order)

@@ -27,6 +27,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ._validate import InputError
+
+RTOL_RANGE = (0.0, 1e-3)
+
 
 @dataclass(frozen=True)
 class Tolerance:
@@ -45,6 +49,25 @@ class Tolerance:
 
     rtol: float = 1e-9
     fold_degrees: float = 20.0
+
+    def __post_init__(self):
+        lo, hi = RTOL_RANGE
+        if isinstance(self.rtol, bool) or not isinstance(self.rtol, (int, float)):
+            raise InputError(f"Tolerance.rtol must be a number, got {self.rtol!r}")
+        if not self.rtol >= lo:
+            raise InputError(f"Tolerance.rtol must be >= 0, got {self.rtol!r}")
+        if not self.rtol <= hi:
+            raise InputError(
+                f"Tolerance.rtol must be within [{lo:g}, {hi:g}], got {self.rtol!r} (a "
+                "tolerance that large ties distances that differ, and neighbourhoods grow "
+                "without bound)"
+            )
+        if isinstance(self.fold_degrees, bool) or not isinstance(self.fold_degrees, (int, float)):
+            raise InputError(f"Tolerance.fold_degrees must be a number, got {self.fold_degrees!r}")
+        if not 0 <= self.fold_degrees < 90:
+            raise InputError(
+                f"Tolerance.fold_degrees must be within [0, 90), got {self.fold_degrees!r}"
+            )
 
 
 DEFAULT = Tolerance()

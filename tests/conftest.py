@@ -23,7 +23,9 @@ _REPORT: dict[str, list[float]] = {}
 
 
 def pytest_runtest_logreport(report):
-    if report.when != "call" or "test_properties.py" not in report.nodeid:
+    if report.when != "call" or not any(
+        f in report.nodeid for f in ("test_properties.py", "test_fuzz.py")
+    ):
         return
     name = report.nodeid.split("::", 1)[1]
     row = _REPORT.setdefault(name, [0, 0.0])
@@ -39,10 +41,11 @@ def pytest_terminal_summary(terminalreporter):
     tr = terminalreporter
     tr.write_line("")
     tr.write_line(f"{'property':<72}{'examples':>9}{'failed':>8}{'seconds':>9}")
+    total = 0
     for name, (failed, secs) in _REPORT.items():
         base = name.split("[")[0].replace("test_", "", 1)
         key = name.split("[")[1].rstrip("]") if "[" in name else ""
-        ex = EXAMPLES.get(
+        ex = EXAMPLES.get(name.replace("test_", "", 1)) or EXAMPLES.get(
             f"homeomorphism[{key}]"
             if "homeomorphism" in base or "sharp" in base
             else {
@@ -54,3 +57,5 @@ def pytest_terminal_summary(terminalreporter):
             0,
         )
         tr.write_line(f"{name:<72}{ex:>9}{'yes' if failed else '-':>8}{secs:>9.1f}")
+        total += ex
+    tr.write_line(f"{'all properties':<72}{total:>9}")

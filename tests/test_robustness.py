@@ -88,13 +88,13 @@ def test_spot_at_extreme_magnitudes_stays_closed():
         assert np.array_equal(rec.triangles, ref.triangles)
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/status")
 @pytest.mark.parametrize("far", [1e4, 1e8])
 def test_one_outlier_keeps_memory_bounded_and_the_cube_closed(far):
     # the cube plus one point at (far, 0, 0) once asked for 41.8 GiB (1e4)
     # and 19.7 PiB (1e8) in the crossing tests' grid
     got = _in_subprocess(
         f"""
-        import resource
         import numpy as np
         from sr33 import reconstruct
         from sr33.samplers import cube_lattice
@@ -102,7 +102,11 @@ def test_one_outlier_keeps_memory_bounded_and_the_cube_closed(far):
         p = np.vstack([cube_lattice(8) / 8.0, [[{far!r}, 0.0, 0.0]]])
         r = reconstruct(p, 33)
         st = mesh_stats(r.triangles, r.vertices.shape[0])
-        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
+        # this process's own peak: VmHWM belongs to the memory map exec made
+        # (ru_maxrss is carried over exec from the forking parent, a pytest
+        # worker of gigabytes)
+        with open("/proc/self/status") as fh:
+            peak = next(int(ln.split()[1]) for ln in fh if ln.startswith("VmHWM:"))  # KiB
         print(peak, st.used_vertices, st.overloaded_edges)
         """
     )

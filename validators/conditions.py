@@ -22,7 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
-from sr33.mesh import SQRT3_2, triangle_ratios, unique_rows
+from sr33.mesh import SQRT3_2, as_mesh, triangle_ratios, unique_rows
+
+OFF_TRUTH = 0.1  # h: farther from the truth, a sample is measured where it snaps, not where it is
+OFF_FRAME = 1.0  # h: a median this far off is another frame or unit, not a sampling
 
 
 @dataclass(frozen=True)
@@ -112,6 +115,11 @@ class ConditionReport:
 
     Attributes
     ----------
+    off_truth : (n,) float64
+        Each sample's distance to the truth, in units of h (the median
+        nearest-sample distance).  The conditions are measured where the
+        samples snap onto the truth, so they mean something only for samples
+        on it: above ``OFF_TRUTH`` h the report fails.
     dt_edges : (m, 2) int64
         Edges of the intrinsic Delaunay triangulation DT_M of the samples.
     dt_triangles : (f, 3) int64
@@ -138,6 +146,7 @@ class ConditionReport:
         of the truth (those entering ``epsilon``).
     """
 
+    off_truth: np.ndarray
     dt_edges: np.ndarray
     dt_triangles: np.ndarray
     edge_length: np.ndarray
@@ -155,6 +164,7 @@ class ConditionReport:
         """Indices of the worst samples per condition (for reports and the GUI)."""
         r = np.where(np.isfinite(self.worst_ratio), self.worst_ratio, -1.0)
         return {
+            "on the truth": np.argsort(-self.off_truth, kind="stable")[:count].tolist(),
             "III-i degree": np.argsort(-self.degree, kind="stable")[:count].tolist(),
             "III-ii ratio": np.argsort(-r, kind="stable")[:count].tolist(),
         }
@@ -168,6 +178,13 @@ class ConditionReport:
     def table(self) -> list[tuple[str, str, str, str]]:
         """(condition, pass/fail, measured figure, worst samples) rows."""
         w = self.worst(5)
+        off = float(self.off_truth.max()) if self.off_truth.size else 0.0
+        ratio = self.max_ratio
+        eps = self.epsilon if np.isfinite(self.epsilon) else 0.0
+        if np.isfinite(ratio):
+            ii = ("pass" if ratio < SQRT3_2 * (1 - eps) else "FAIL", f"{ratio:.4f}")
+        else:
+            ii = ("not measured", "no DT_M triangle")
         return [
             (
                 "III-i  DT_M degree <= 33",
@@ -177,12 +194,17 @@ class ConditionReport:
             ),
             (
                 "III-ii shorter edges < sqrt(3)/2 longest",
-                "pass" if self.max_ratio < SQRT3_2 * (1 - self.epsilon) else "FAIL",
-                f"{self.max_ratio:.4f}",
+                *ii,
                 str(w["III-ii ratio"]),
             ),
             ("II-ii  geodesic distortion epsilon", "info", f"{self.epsilon:.4g}", "-"),
             self._ii_iv_row(),
+            (
+                f"samples on the truth (<= {OFF_TRUTH} h)",
+                "pass" if off <= OFF_TRUTH else "FAIL",
+                f"{off:.3g} h",
+                str(w["on the truth"]),
+            ),
         ]
 
 
@@ -573,13 +595,30 @@ def sample_conditions(
     from .refine import insert_points, refine_to_edge_length
     from .signature import signature
 
-    pts = np.asarray(points, dtype=np.float64)
+    pts, _ = as_mesh(points, np.empty((0, 3), dtype=np.int64), name="points")
     n = pts.shape[0]
+    if n < 3:
+        raise ValueError(f"points: the conditions need at least 3 samples, got {n}")
+    ov, of = as_mesh(truth_vertices, truth_triangles, name="truth")
+    if of.shape[0] == 0:
+        raise ValueError("truth: the conditions need a triangle mesh, got no triangles")
+    from .fidelity import distance_to_surface
+
+    nn, _ = cKDTree(pts).query(pts, 2)
+    spacing = float(np.median(nn[:, 1]))
+    if not spacing > 0:
+        raise ValueError("points: more than half of the samples are duplicates (spacing 0)")
+    off = distance_to_surface(pts, ov, of) / spacing
+    if np.median(off) > OFF_FRAME:
+        raise ValueError(
+            f"the samples are off the truth by {np.median(off):.3g} h (median; max "
+            f"{off.max():.3g} h, h = {spacing:.3g} the median sample spacing): are points and "
+            "truth in the same frame and units?"
+        )
     if resolution is None:
-        nn, _ = cKDTree(pts).query(pts, 2)
-        resolution = float(np.median(nn[:, 1])) / 5.0
-    ov = np.asarray(truth_vertices, dtype=np.float64)
-    of = np.asarray(truth_triangles, dtype=np.int64)
+        resolution = spacing / 5.0
+    if not (np.isfinite(resolution) and resolution > 0):
+        raise ValueError(f"resolution must be a positive length, got {resolution}")
     genus = tuple(c.genus for c in signature(of, ov.shape[0]).components)
     with timed("conditions: truth refined"):
         tv, tf = refine_to_edge_length(ov, of, resolution)
@@ -646,6 +685,7 @@ def sample_conditions(
     eu = np.linalg.norm(tv[snap[dt_edges[:, 0]]] - tv[snap[dt_edges[:, 1]]], axis=1)
     eps = float((length[both] / eu[both] - 1).max()) if both.any() else float("nan")
     return ConditionReport(
+        off_truth=off,
         dt_edges=dt_edges,
         dt_triangles=dt_tri,
         edge_length=length,

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sr33.mesh import edge_incidence, half_edges, surface_points, unique_rows
+from sr33.mesh import as_mesh, edge_incidence, half_edges, surface_points, unique_rows
 
 __all__ = [
     "Fidelity",
@@ -61,11 +61,8 @@ class Fidelity:
 def _polydata(vertices, triangles):
     import pyvista as pv
 
-    v = np.asarray(vertices, dtype=np.float64)
-    t = np.asarray(triangles, dtype=np.int64)
-    if v.ndim != 2 or v.shape[1] != 3:
-        raise ValueError(f"vertices must have shape (n, 3), got {v.shape}")
-    if t.ndim != 2 or t.shape[1] != 3 or t.shape[0] == 0:
+    v, t = as_mesh(vertices, triangles)
+    if t.shape[0] == 0:
         raise ValueError(f"triangles must have shape (t, 3) with t > 0, got {t.shape}")
     faces = np.hstack([np.full((t.shape[0], 1), 3, dtype=np.int64), t]).ravel()
     return pv.PolyData(v, faces)
