@@ -382,7 +382,7 @@ def write_mesh(path, vertices: np.ndarray, triangles: np.ndarray) -> Path:
     with atomic_output(path, MESH_FORMATS, "output") as (tmp, ext):
         if ext == ".vtp":
             faces = np.hstack([np.full((t.shape[0], 1), 3, dtype=np.int64), t]).ravel()
-            _pyvista(path).PolyData(v, faces).save(tmp, binary=True)
+            _write_vtp(tmp, _pyvista(path).PolyData(v, faces))
         elif ext == ".obj":
             with open(tmp, "w", encoding="ascii") as fh:
                 fh.write("# written by sr33\n")
@@ -426,8 +426,24 @@ def write_points(path, points: np.ndarray, fields: dict[str, np.ndarray] | None 
             cloud = _pyvista(path).PolyData(v)
             for k, a in fields.items():
                 cloud.point_data[k] = a
-            cloud.save(tmp, binary=True)
+            _write_vtp(tmp, cloud)
     return Path(path)
+
+
+def _write_vtp(tmp: str, poly) -> None:
+    """VTK XML PolyData (binary, base64), serialised by VTK in memory and
+    written by Python: VTK's own file writer crashes the process (SIGSEGV)
+    when the disk fills up, where Python raises ``OSError``."""
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
+
+    w = vtkXMLPolyDataWriter()
+    w.SetInputData(poly)
+    w.SetDataModeToBinary()
+    w.WriteToOutputStringOn()
+    if not w.Write():
+        raise WriteError(f"{tmp}: VTK could not serialise the mesh")
+    with open(tmp, "w", encoding="ascii") as fh:
+        fh.write(w.GetOutputString())
 
 
 def write_text(path, text: str) -> Path:

@@ -3,6 +3,10 @@ byte-order marks, non-finite vertices and bad face indices give one line
 naming the file and the problem, exit 2, in every subcommand that reads a
 mesh."""
 
+import subprocess
+import sys
+import textwrap
+
 import numpy as np
 import pytest
 
@@ -183,3 +187,37 @@ def test_the_validators_refuse_a_non_finite_truth_at_once():
         sample_conditions(TETRA * 0.5, v, FACES)
     with pytest.raises(ValueError, match=r"^mesh: 1 of 4 vertices have non-finite"):
         hausdorff(TETRA, FACES, v, FACES)
+
+
+# --- item 7: a full disk ------------------------------------------------------
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="needs RLIMIT_FSIZE")
+def test_a_full_disk_is_a_write_error_in_every_format_and_leaves_nothing(tmp_path):
+    # writing .vtp on a full disk once crashed the process (VTK's file writer,
+    # SIGSEGV) and left its temporary file; a file-size limit fails writes
+    # the way a full disk does (EFBIG instead of ENOSPC)
+    pytest.importorskip("pyvista")
+    code = textwrap.dedent(
+        f"""
+        import resource, signal
+        import numpy as np
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))
+        from sr33.io import WriteError, write_mesh, write_points
+        rng = np.random.default_rng(0)
+        v, t = rng.random((5000, 3)), rng.integers(0, 5000, (9000, 3))
+        jobs = [(write_mesh, e, (v, t)) for e in ("vtp", "ply", "obj", "stl", "off")]
+        jobs += [(write_points, e, (v,)) for e in ("vtp", "ply", "xyz", "npy", "obj")]
+        for fn, ext, args in jobs:
+            try:
+                fn({str(tmp_path)!r} + "/out." + ext, *args)
+                print(ext, "written")
+            except WriteError as exc:
+                print(ext, "cannot write" in str(exc))
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert [line.split()[1] for line in out.stdout.splitlines()] == ["True"] * 10, out.stdout
+    assert list(tmp_path.iterdir()) == []

@@ -133,9 +133,11 @@ def messy_points(draw) -> np.ndarray:
     if draw(st.booleans()):
         p = np.vstack([p, p[rng.integers(0, len(p), draw(st.integers(1, 10)))]])
     scale = 10.0 ** draw(st.sampled_from([0, -300, -150, -9, 9, 150, 300]))
-    p = p * scale
-    if draw(st.booleans()):
-        p = p + np.array(draw(st.sampled_from([[5e5, 4.1e6, 250.0], [1e7, -3e7, 0.0]]))) * scale
+    with np.errstate(over="ignore", invalid="ignore"):  # inf is input too: refused
+        p = p * scale
+        if draw(st.booleans()):
+            offset = draw(st.sampled_from([[5e5, 4.1e6, 250.0], [1e7, -3e7, 0.0]]))
+            p = p + np.array(offset) * scale
     return p[rng.permutation(len(p))]
 
 
