@@ -9,52 +9,9 @@ by the documented tolerance and nothing else.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
-
 import numpy as np
-from numba import njit as _njit
 
-
-def njit(*args, **kwargs):
-    """``numba.njit`` with ``cache=True`` where numba can cache: when neither
-    the package folder nor a user cache folder (``$NUMBA_CACHE_DIR``,
-    ``~/.cache``) is writable, numba refuses ``cache=True`` at import; the
-    kernels then compile once per process instead."""
-
-    def wrap(fn):
-        try:
-            d = _njit(**kwargs)(fn)
-        except RuntimeError:  # "cannot cache function ...: no locator available"
-            kwargs.pop("cache", None)
-            d = _njit(**kwargs)(fn)
-        return d
-
-    return wrap(args[0]) if args and callable(args[0]) else wrap
-
-
-@contextmanager
-def compile_notice(notify) -> Iterator[None]:
-    """Within the block, call ``notify()`` once when numba starts compiling a
-    kernel of this module (a first run, or a cache that does not fit this
-    machine: about 13 s for all of them); loading a cached kernel is silent."""
-    from numba.core import event
-
-    told = []
-
-    class _Listener(event.Listener):
-        def on_start(self, ev):
-            d = ev.data.get("dispatcher") if ev.data else None
-            fn = getattr(d, "py_func", None)
-            if not told and getattr(fn, "__module__", None) == __name__:
-                told.append(True)
-                notify()
-
-        def on_end(self, ev):
-            pass
-
-    with event.install_listener("numba:compile", _Listener()):
-        yield
+from ._numba import njit
 
 
 @njit(cache=True)

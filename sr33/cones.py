@@ -29,10 +29,11 @@ from ._validate import InputError, as_points
 from .mesh import (
     closest_points_on_triangles,
     cross,
+    crossing_eps,
     dot,
+    first_crossing,
     half_edges,
     norm,
-    self_intersections,
     unique_rows,
 )
 
@@ -150,6 +151,7 @@ def attach_cones(
     # ``rad`` of the stray: the usual ancestors are found in the tree (within
     # span plus ``small``), the few long ones (loop faces) are always tried
     rad = norm(pts[tri] - cen0[:, None]).max(axis=1)
+    eps = crossing_eps(pts)
     small = 4.0 * float(np.median(rad))
     long_ones = set(np.flatnonzero(rad > small).tolist())
 
@@ -182,9 +184,7 @@ def attach_cones(
         for _, old, new in solid:
             keep_i = [k for k, i in enumerate(around) if i not in old]
             patch = np.vstack([np.array(new, dtype=np.int64), local[keep_i]])
-            m = len(new)
-            hits = self_intersections(pts, patch, keep=lambda a, b, m=m: (a < m) | (b < m))
-            if not hits.shape[0]:
+            if first_crossing(pts, patch, len(new), eps) is None:
                 pick = (old, new)
                 break
         if pick is None:  # every insertion crosses something: the nearest one
@@ -293,6 +293,7 @@ def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
     manifold = {tuple(k) for k in keys[counts == 2].tolist()}
     near[np.unique(keys[counts != 2])] = False
     limit = np.radians(165.0)
+    eps = crossing_eps(pts)
 
     def across(a, b):
         k = owner.get((b, a))
@@ -329,7 +330,7 @@ def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
             ext = float(norm(pts[new.ravel()] - mid).max())
             local = [k for k in tree.query_ball_point(mid, ext + radius) if k != i and k != j]
             patch = np.vstack([new, tri[local]]) if local else new
-            if self_intersections(pts, patch, keep=lambda a, b: (a < 2) | (b < 2)).shape[0]:
+            if first_crossing(pts, patch, 2, eps) is not None:
                 continue
             for key in ((p, q), (q, r), (r, p), (q, p), (p, s_), (s_, q)):
                 owner.pop(key, None)

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
-from scipy.spatial import cKDTree
+
+from . import _intersect
 
 SQRT3_2 = float(np.sqrt(3.0) / 2.0)  # Condition III-ii: shorter edges below this times the longest
 
@@ -413,87 +414,25 @@ def surface_points(vertices, triangles, count: int, seed: int = 0) -> np.ndarray
 # --- triangle intersection -------------------------------------------------
 
 
-def _segments_cross_triangles(p0, p1, a, b, c, eps):
-    """Vectorized: does the open segment p0-p1 cross the triangle abc (interior or edge)?"""
-    d = p1 - p0
-    e1, e2 = b - a, c - a
-    h = cross(d, e2)
-    det = np.einsum("ij,ij->i", e1, h)
-    ok = np.abs(det) > eps
-    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    s = p0 - a
-    u = inv * np.einsum("ij,ij->i", s, h)
-    q = cross(s, e1)
-    v = inv * np.einsum("ij,ij->i", d, q)
-    t = inv * np.einsum("ij,ij->i", e2, q)
-    tol = 1e-12
-    return ok & (u >= -tol) & (v >= -tol) & (u + v <= 1 + tol) & (t > tol) & (t < 1 - tol)
-
-
 def _candidate_pairs(lo: np.ndarray, hi: np.ndarray, keep=None) -> np.ndarray:
-    """Pairs of boxes that may overlap, found with a k-d tree (memory bounded by
-    the number of pairs found, not by the extent of the boxes).
-
-    Box i is a ball of radius ``r_i`` (half its largest side) round its centre
-    in the maximum norm; two boxes can overlap only if their centres are
-    within ``r_i + r_j <= 2 max(r_i, r_j)``, so each pair is found by a
-    :class:`scipy.spatial.cKDTree` query of radius ``2 r_i`` from its larger
-    box.  Boxes over eight times the median radius (an outlier's long
-    triangles) are compared with every box directly, in chunks.  ``keep`` (if given)
-    filters the pairs before deduplication; each pair is reported once.
-    """
-    n = lo.shape[0]
-    if n <= 192:  # a patch: every pair, no tree
-        a, b = np.triu_indices(n, 1)
-        ok = np.all((lo[a] <= hi[b]) & (lo[b] <= hi[a]), axis=1)
-        if keep is not None:
-            ok &= keep(a, b)
-        return np.stack([a[ok], b[ok]], axis=1).astype(np.int64)
-    centre = 0.5 * lo + 0.5 * hi  # no overflow at 1e308
-    radius = (0.5 * hi - 0.5 * lo).max(axis=1)
-    typical = float(np.median(radius))
-    big = radius > 8.0 * typical if typical > 0 else np.zeros(n, dtype=bool)
-    small = np.flatnonzero(~big)
-    found_a, found_b = [], []
-    if small.shape[0] > 1:
-        # overlapping boxes have centres within r_i + r_j <= 2 max(r_i, r_j):
-        # every pair is found from its larger box, querying 2 r_i
-        tree = cKDTree(centre[small])
-        hits = tree.query_ball_point(centre[small], 2.0 * radius[small], p=np.inf)
-        counts = np.fromiter((len(h) for h in hits), dtype=np.int64, count=len(hits))
-        if counts.sum():
-            a = np.repeat(small, counts)
-            b = small[np.concatenate([np.asarray(h, dtype=np.int64) for h in hits])]
-            larger = radius[a] >= radius[b]
-            found_a.append(a[larger])
-            found_b.append(b[larger])
-    for i in np.flatnonzero(big).tolist():
-        for s0 in range(0, n, 65536):
-            j = np.arange(s0, min(n, s0 + 65536))
-            ok = np.all((lo[j] <= hi[i]) & (lo[i] <= hi[j]), axis=1)
-            found_a.append(np.full(int(ok.sum()), i, dtype=np.int64))
-            found_b.append(j[ok])
-    if not found_a:
-        return np.empty((0, 2), dtype=np.int64)
-    a, b = np.concatenate(found_a), np.concatenate(found_b)
-    ok = a != b
-    if keep is not None:
-        ok &= keep(a, b)
-    a, b = a[ok], b[ok]
-    if a.shape[0] == 0:
-        return np.empty((0, 2), dtype=np.int64)
-    keys = np.unique(edge_keys(a, b, n))
-    return np.stack([keys // n, keys % n], axis=1)
+    """Pairs (i, j), i < j, of overlapping boxes, sorted, filtered by ``keep``
+    (:func:`sr33._intersect.box_pairs`: a grid whose memory follows the
+    number of boxes, not their extent)."""
+    pairs = _intersect.box_pairs(np.ascontiguousarray(lo), np.ascontiguousarray(hi))
+    if keep is not None and pairs.shape[0]:
+        pairs = pairs[np.asarray(keep(pairs[:, 0], pairs[:, 1]), dtype=bool)]
+    return pairs
 
 
 def self_intersections(vertices, triangles, keep=None) -> np.ndarray:
     """Pairs (i, j), i < j, of triangles whose interiors intersect.
 
     The paper requires the triangles of the output to have pairwise disjoint
-    interiors (Section 4, Triangulate).  Candidate pairs share a cell of a
-    grid and overlap as boxes; each is decided by exact segment–triangle
-    tests (Möller–Trumbore): two non-coplanar triangles intersect exactly
-    when an edge of one crosses the other.  Pairs sharing an edge are
+    interiors (Section 4, Triangulate).  Candidate pairs have overlapping
+    boxes (a hashed grid); each is decided by exact segment–triangle tests
+    (Möller–Trumbore; both are numba kernels, :mod:`sr33._intersect`): two
+    non-coplanar triangles intersect exactly when an edge of one crosses
+    the other.  Pairs sharing an edge are
     adjacent, not intersecting, unless they fold onto each other (coplanar
     and on the same side); pairs sharing one vertex intersect when an edge
     not at that vertex crosses the other.
@@ -521,44 +460,40 @@ def self_intersections(vertices, triangles, keep=None) -> np.ndarray:
     if t.shape[0] < 2:
         return np.empty((0, 2), dtype=np.int64)
     p = v[t]
-    scale = float(np.abs(v).max()) or 1.0
-    eps = 1e-14 * scale * scale
     lo, hi = p.min(axis=1), p.max(axis=1)
     pairs = _candidate_pairs(lo, hi, keep)
     if pairs.shape[0] == 0:
         return np.empty((0, 2), dtype=np.int64)
-    i, j = pairs[:, 0], pairs[:, 1]
-    box = np.all((lo[i] <= hi[j]) & (lo[j] <= hi[i]), axis=1)
-    i, j = i[box], j[box]
-    ti, tj = t[i], t[j]
-    shared = (ti[:, :, None] == tj[:, None, :]).sum(axis=(1, 2))
-    hit = np.zeros(i.shape[0], dtype=bool)
-    # edges of one triangle that do not touch a shared vertex, against the other
-    for dst, ts, td in ((j, ti, tj), (i, tj, ti)):
-        for k in range(3):
-            a_idx, b_idx = ts[:, k], ts[:, (k + 1) % 3]
-            touches = (a_idx[:, None] == td).any(axis=1) | (b_idx[:, None] == td).any(axis=1)
-            sel = np.flatnonzero(~touches)
-            if not sel.size:
-                continue
-            r = _segments_cross_triangles(
-                v[a_idx[sel]], v[b_idx[sel]], p[dst[sel], 0], p[dst[sel], 1], p[dst[sel], 2], eps
-            )
-            hit[sel[r]] = True
-    # pairs sharing an edge: a fold when the two third vertices are coplanar and on one side
-    two = np.flatnonzero((shared == 2) & ~hit)
-    if two.shape[0]:
-        a, b = ti[two], tj[two]
-        in_b = (a[:, :, None] == b[:, None, :]).any(axis=2)
-        in_a = (b[:, :, None] == a[:, None, :]).any(axis=2)
-        oa = a[~in_b]
-        ob = b[~in_a]
-        common = a[in_b].reshape(-1, 2)
-        e0, e1 = v[common[:, 0]], v[common[:, 1]]
-        na = cross(e1 - e0, v[oa] - e0)
-        nb = cross(e1 - e0, v[ob] - e0)
-        la, lb = np.linalg.norm(na, axis=1), np.linalg.norm(nb, axis=1)
-        cos = np.einsum("ij,ij->i", na, nb) / np.maximum(la * lb, 1e-300)
-        hit[two[cos > 1 - 1e-12]] = True
-    out = np.stack([np.minimum(i[hit], j[hit]), np.maximum(i[hit], j[hit])], axis=1)
-    return unique_rows(out) if out.shape[0] else out.reshape(0, 2)
+    # candidate rows are sorted and unique (i < j): so are the hits
+    return pairs[_intersect.pairs_meet(v, t, pairs, crossing_eps(v))]
+
+
+def crossing_eps(vertices: np.ndarray) -> float:
+    """The determinant below which :func:`self_intersections` treats a segment
+    as parallel to a triangle: ``1e-14`` times the squared largest coordinate
+    magnitude of ``vertices`` (1 when all are 0)."""
+    scale = float(np.abs(vertices).max()) if vertices.size else 0.0
+    scale = scale or 1.0
+    return 1e-14 * scale * scale
+
+
+def first_crossing(vertices: np.ndarray, patch: np.ndarray, new: int, eps: float):
+    """The first pair ``(i, j)``, ``i < j``, ``i < new``, of rows of ``patch``
+    whose interiors meet (the predicate of :func:`self_intersections`), or
+    ``None``: a few new triangles (the first ``new`` rows) against each other
+    and the triangles round them, without the set-up of a whole-mesh search.
+
+    ``vertices`` must be float64 ``(n, 3)`` and ``patch`` int64 ``(t, 3)``
+    within range (they are not checked: this is the inner loop of the cones,
+    the flips and the hole closing); ``eps`` from :func:`crossing_eps` of the
+    whole vertex array.
+
+    Examples
+    --------
+    >>> v = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0],
+    ...               [0.5, 0.5, -1], [0.5, 0.5, 1], [3, 3, 0]], float)
+    >>> first_crossing(v, np.array([(3, 4, 5), (0, 1, 2)]), 1, crossing_eps(v))
+    (0, 1)
+    """
+    i, j = _intersect.first_crossing(vertices, patch, new, eps)
+    return None if i < 0 else (int(i), int(j))

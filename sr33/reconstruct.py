@@ -15,7 +15,7 @@ from scipy import sparse
 from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
-from ._kernels import compile_notice
+from ._numba import compile_notice
 from ._validate import InputError, as_points, check_k, check_max_cycle_length, check_not_degenerate
 from .backtracking import backtracking
 from .cones import attach_cones, ring_centres

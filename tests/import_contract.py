@@ -38,8 +38,9 @@ FOLDERS = {
     "gui": "sr33.gui",
 }
 
-# the low layer: mesh primitives, progress bars and step timing
-BASE = {"sr33.mesh", "sr33.progress"}
+# the low layer: mesh primitives (and their numba kernels), progress bars and
+# step timing
+BASE = {"sr33.mesh", "sr33.progress", "sr33._intersect", "sr33._numba"}
 TOP = {"sr33", "sr33.cli"}  # the hub and the command line see everything
 
 ALLOWED = {

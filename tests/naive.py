@@ -139,3 +139,68 @@ def naive_flip_costs(points: np.ndarray, quad, across):
         turns.append(turn(new2 if k in (0, 3) else new1, across[k]))
         after += length(a, b) * turns[-1]
     return before, after, max(turns)
+
+
+def _segments_cross_triangles(p0, p1, a, b, c, eps):
+    """Vectorized Möller–Trumbore: does the open segment p0-p1 cross triangle abc?"""
+    from sr33.mesh import cross
+
+    d = p1 - p0
+    e1, e2 = b - a, c - a
+    h = cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, h)
+    ok = np.abs(det) > eps
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    s = p0 - a
+    u = inv * np.einsum("ij,ij->i", s, h)
+    q = cross(s, e1)
+    v = inv * np.einsum("ij,ij->i", d, q)
+    t = inv * np.einsum("ij,ij->i", e2, q)
+    tol = 1e-12
+    return ok & (u >= -tol) & (v >= -tol) & (u + v <= 1 + tol) & (t > tol) & (t < 1 - tol)
+
+
+def naive_self_intersections(v: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Every pair of triangles tested with numpy (the kernel's reference):
+    box overlap, then an edge of one crossing the other (edges touching the
+    other's vertices skipped), then the fold of two triangles on one edge."""
+    from sr33.mesh import cross
+
+    if t.shape[0] < 2:
+        return np.empty((0, 2), dtype=np.int64)
+    p = v[t]
+    scale = float(np.abs(v).max()) or 1.0
+    eps = 1e-14 * scale * scale
+    lo, hi = p.min(axis=1), p.max(axis=1)
+    i, j = np.triu_indices(t.shape[0], 1)
+    box = np.all((lo[i] <= hi[j]) & (lo[j] <= hi[i]), axis=1)
+    i, j = i[box], j[box]
+    ti, tj = t[i], t[j]
+    shared = (ti[:, :, None] == tj[:, None, :]).sum(axis=(1, 2))
+    hit = np.zeros(i.shape[0], dtype=bool)
+    for dst, ts, td in ((j, ti, tj), (i, tj, ti)):
+        for k in range(3):
+            a_idx, b_idx = ts[:, k], ts[:, (k + 1) % 3]
+            touches = (a_idx[:, None] == td).any(axis=1) | (b_idx[:, None] == td).any(axis=1)
+            sel = np.flatnonzero(~touches)
+            if not sel.size:
+                continue
+            r = _segments_cross_triangles(
+                v[a_idx[sel]], v[b_idx[sel]], p[dst[sel], 0], p[dst[sel], 1], p[dst[sel], 2], eps
+            )
+            hit[sel[r]] = True
+    two = np.flatnonzero((shared == 2) & ~hit)
+    if two.shape[0]:
+        a, b = ti[two], tj[two]
+        in_b = (a[:, :, None] == b[:, None, :]).any(axis=2)
+        in_a = (b[:, :, None] == a[:, None, :]).any(axis=2)
+        oa = a[~in_b]
+        ob = b[~in_a]
+        common = a[in_b].reshape(-1, 2)
+        e0, e1 = v[common[:, 0]], v[common[:, 1]]
+        na = cross(e1 - e0, v[oa] - e0)
+        nb = cross(e1 - e0, v[ob] - e0)
+        la, lb = np.linalg.norm(na, axis=1), np.linalg.norm(nb, axis=1)
+        cos = np.einsum("ij,ij->i", na, nb) / np.maximum(la * lb, 1e-300)
+        hit[two[cos > 1 - 1e-12]] = True
+    return np.stack([i[hit], j[hit]], axis=1).astype(np.int64)

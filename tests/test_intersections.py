@@ -1,11 +1,19 @@
 """validators.intersections: crossing, touching, folded and clean meshes."""
 
+import os
+
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sr33 import reconstruct
+from sr33.mesh import crossing_eps, first_crossing
 from sr33.samplers import cube_lattice
 from sr33.validators.intersections import self_intersections
 from tests.meshes import icosphere
+from tests.naive import naive_self_intersections
+
+DEEP = os.environ.get("HYPOTHESIS_PROFILE") == "deep"
 
 
 def test_two_crossing_triangles_are_one_pair():
@@ -58,3 +66,62 @@ def test_one_far_outlier_costs_memory_by_the_pairs_not_the_extent():
         tracemalloc.stop()
         assert peak < 200e6
         assert hits.shape[0] > 0 and np.all(hits[:, 1] == t.shape[0] - 1)
+
+
+@st.composite
+def triangle_soups(draw):
+    """Triangles on a few lattice points (coplanar sets, shared edges and
+    vertices, folds are common), some points jittered off the lattice."""
+    n = draw(st.integers(4, 12))
+    v = np.array(draw(st.lists(st.tuples(*[st.integers(-2, 2)] * 3), min_size=n, max_size=n)))
+    v = v.astype(float)
+    if draw(st.booleans()):
+        seed = draw(st.integers(0, 2**16))
+        v += np.random.default_rng(seed).normal(0, 0.3, v.shape) * (np.arange(n) % 2)[:, None]
+    tris = draw(
+        st.lists(
+            st.lists(st.integers(0, n - 1), min_size=3, max_size=3, unique=True),
+            min_size=2,
+            max_size=14,
+        )
+    )
+    return v, np.array(tris, dtype=np.int64)
+
+
+@settings(max_examples=300 if DEEP else 60, deadline=None)
+@given(soup=triangle_soups(), new=st.integers(1, 4))
+def test_the_kernel_finds_the_pairs_numpy_finds(soup, new):
+    """self_intersections (numba kernel, k-d tree candidates) against the
+    vectorized numpy reference over every pair; first_crossing against the
+    first reference pair that involves one of the first ``new`` rows."""
+    v, t = soup
+    want = naive_self_intersections(v, t)
+    assert self_intersections(v, t).tolist() == want.tolist()
+    firsts = [tuple(r) for r in want.tolist() if r[0] < new]
+    assert first_crossing(v, t, new, crossing_eps(v)) == (firsts[0] if firsts else None)
+
+
+@st.composite
+def boxes(draw):
+    """Boxes round lattice centres: equal, nested, touching (closed boxes
+    share a face), zero-size, and a few far larger than the rest."""
+    n = draw(st.integers(2, 60))
+    seed = draw(st.integers(0, 2**16))
+    rng = np.random.default_rng(seed)
+    c = rng.integers(-4, 5, (n, 3)).astype(float) * draw(st.sampled_from([1.0, 1e-9, 1e9]))
+    scale = np.abs(c).max() or 1.0
+    r = rng.integers(0, 3, (n, 3)) * 0.5 * scale / 4
+    big = rng.random(n) < draw(st.sampled_from([0.0, 0.05, 0.3]))
+    r[big] *= 40
+    return c - r, c + r
+
+
+@settings(max_examples=300 if DEEP else 60, deadline=None)
+@given(b=boxes())
+def test_box_pairs_are_every_overlapping_pair(b):
+    from sr33._intersect import box_pairs
+
+    lo, hi = b
+    i, j = np.triu_indices(lo.shape[0], 1)
+    ok = np.all((lo[i] <= hi[j]) & (lo[j] <= hi[i]), axis=1)
+    assert box_pairs(lo, hi).tolist() == np.stack([i[ok], j[ok]], 1).tolist()
