@@ -42,9 +42,10 @@ This module searches the same space, made tractable by four observations:
    assignments.  When the strict search fails or exhausts the budget (acute
    sharp edges, where the RNG cuts across the edge and covering every
    sample is impossible, or input that does not meet the sample
-   conditions), the component falls back to a greedy pass in rank order
-   that keeps the invariant (no edge above two uses, no vertex link that is
-   not a disk), and then to the exact selection of :mod:`sr33.selection`
+   conditions), the component falls back to a greedy pass that grows the
+   surface from its boundary, as Algorithm 4 does, keeping the invariant
+   (no edge above two uses, no vertex link that is not a disk; see
+   :func:`_front_greedy`), and then to the exact selection of :mod:`sr33.selection`
    over the failed components and the cycles fixed next to them because of
    an edge in no other candidate; it allows stray samples, as the paper's
    success condition does, and its answer replaces the greedy one only
@@ -542,24 +543,16 @@ def _solve_component(prob: _Problem, comp, state, rank, conflicts, budget):
     return ok, counter[0]
 
 
-def _greedy(prob: _Problem, comp, state, rank, conflicts):
-    """Fallback: add cycles in rank order while edge use <= 2 and links stay disks."""
-    comp = sorted(comp, key=lambda c: rank[c])
-    for c in comp:
-        state[c] = 0
-    use: dict[int, int] = {}
-    for c in comp:
-        for e in prob.cycle_edge_ids[c]:
-            e = int(e)
-            if e not in use:
-                use[e] = int(sum(1 for d in prob.cycles_at_edge(e) if state[d] == 1))
-    for c in comp:
-        if any(use[int(e)] >= 2 for e in prob.cycle_edge_ids[c]):
-            continue
-        if any(state[d] == 1 for d in conflicts.get(c, ())):
-            continue
-        state[c] = 1
-        ok = True
+def _addable(prob: _Problem, c: int, state, use, conflicts) -> bool:
+    """Whether cycle ``c`` keeps the invariant: no edge above two uses, no
+    conflict with a selected cycle, every vertex link still able to become
+    a disk."""
+    if any(use[int(e)] >= 2 for e in prob.cycle_edge_ids[c]):
+        return False
+    if any(state[d] == 1 for d in conflicts.get(c, ())):
+        return False
+    state[c] = 1
+    try:
         for v in prob.cycle_vertices[c]:
             cyc, corner = prob.corners_at_vertex(int(v))
             pairs = [
@@ -568,13 +561,86 @@ def _greedy(prob: _Problem, comp, state, rank, conflicts):
                 if state[d] == 1
             ]
             if not _link_is_partial_ok(pairs):
-                ok = False
-                break
-        if not ok:
-            state[c] = 0
-            continue
+                return False
+        return True
+    finally:
+        state[c] = 0
+
+
+def _front_greedy(prob: _Problem, comp, state, rank, conflicts):
+    """Fallback: grow the surface from its boundary, as Algorithm 4 does.
+
+    Algorithm 4 adds a cycle only where it meets the basis along an edge used
+    once (its rule ii).  This takes that order greedily: of the cycles that
+    touch the current boundary and keep the invariant (:func:`_addable`), the
+    one that closes the most boundary edges net of the new ones it opens
+    (edges used once minus edges unused), then the best-ranked; when no
+    cycle touches the boundary, the best-ranked addable cycle starts a new
+    front.  A cycle that breaks the invariant once never becomes addable
+    again (edge uses and conflicts only grow; a link that cannot become a
+    disk stays so), so each is rejected at most once.  Deterministic: the
+    rank is a total order.
+    """
+    import heapq
+
+    comp = sorted(comp, key=lambda c: rank[c])
+    for c in comp:
+        state[c] = 0
+    use: dict[int, int] = {}
+    at_edge: dict[int, list[int]] = {}
+    for c in comp:
         for e in prob.cycle_edge_ids[c]:
-            use[int(e)] += 1
+            e = int(e)
+            at_edge.setdefault(e, []).append(c)
+            if e not in use:
+                use[e] = int(sum(1 for d in prob.cycles_at_edge(e) if state[d] == 1))
+    dead: set[int] = set()
+
+    def key(c):
+        ones = sum(1 for e in prob.cycle_edge_ids[c] if use[int(e)] == 1)
+        zeros = sum(1 for e in prob.cycle_edge_ids[c] if use[int(e)] == 0)
+        return ones, (zeros - ones, int(rank[c]))
+
+    heap: list = []
+    current: dict[int, tuple] = {}
+
+    def push(c):
+        ones, k = key(c)
+        current[c] = k
+        if ones:
+            heapq.heappush(heap, (k, c))
+
+    for c in comp:
+        push(c)
+    seeds = iter(comp)
+    while True:
+        pick = None
+        while heap:
+            k, c = heapq.heappop(heap)
+            if state[c] == 1 or c in dead or current.get(c) != k:
+                continue  # stale entry
+            if _addable(prob, c, state, use, conflicts):
+                pick = c
+                break
+            dead.add(c)
+        if pick is None:  # nothing touches the boundary: a new front
+            for c in seeds:
+                if state[c] != 1 and c not in dead:
+                    if _addable(prob, c, state, use, conflicts):
+                        pick = c
+                        break
+                    dead.add(c)
+        if pick is None:
+            return
+        state[pick] = 1
+        touched = set()
+        for e in prob.cycle_edge_ids[pick]:
+            e = int(e)
+            use[e] += 1
+            touched.update(at_edge[e])
+        for d in sorted(touched):
+            if state[d] != 1 and d not in dead:
+                push(d)
 
 
 def _region(prob: _Problem, failed: list[int], lone_edge: np.ndarray, n: int) -> np.ndarray:
@@ -733,7 +799,7 @@ def backtracking(
                     state[:] = snapshot
                     fallback += 1
                     failed.extend(comp)
-                    _greedy(prob, comp, state, rank, conflicts)
+                    _front_greedy(prob, comp, state, rank, conflicts)
                 pbar.update(1)
     finally:
         sys.setrecursionlimit(old_limit)
