@@ -175,8 +175,9 @@ def attach_cones(
         _, near = tree.query(pts[p], kq)
         cand = sorted({j for o in np.atleast_1d(near).tolist() for j in family[o]})
         options = _insertions(pts, p, cand, tris, owner)
-        solid = [o for o in options if not _flat(pts, o[2])] or options
-        span = max(float(norm(pts[np.array(o[2]).ravel()] - pts[p]).max()) for o in solid)
+        flat, reach = _flat_and_reach(pts, p, options)
+        solid = [o for o, f in zip(options, flat) if not f] or options
+        span = float(reach[~flat].max() if (~flat).any() else reach.max())
         near_all = tree.query_ball_point(pts[p], span + small)
         around = sorted({j for o in list(near_all) + sorted(long_ones) for j in family[o]})
         local = np.array([tris[i] for i in around], dtype=np.int64).reshape(-1, 3)
@@ -202,12 +203,21 @@ def attach_cones(
     return out, strays
 
 
-def _flat(pts, triangles) -> bool:
-    """Whether a triangle has (numerically) no area: its sample on an edge's line."""
-    t = pts[np.asarray(triangles, dtype=np.int64)]
-    cr = cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
-    longest = max(float(norm(t[:, 1] - t[:, 0]).max()), float(norm(t[:, 2] - t[:, 0]).max()))
-    return bool(np.any(norm(cr) <= 1e-9 * longest * longest))
+def _flat_and_reach(pts, p: int, options) -> tuple[np.ndarray, np.ndarray]:
+    """Per insertion option: whether one of its new triangles has
+    (numerically) no area (its sample on an edge's line: area below 1e-9
+    times the square of the option's longest edge from a first corner), and
+    the farthest of its corners from sample ``p``."""
+    sizes = np.array([len(o[2]) for o in options], dtype=np.int64)
+    t = pts[np.array([tr for o in options for tr in o[2]], dtype=np.int64)]
+    starts = np.r_[0, np.cumsum(sizes)[:-1]]
+    e1, e2 = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
+    longest = np.maximum.reduceat(np.maximum(norm(e1), norm(e2)), starts)
+    owner = np.repeat(np.arange(sizes.shape[0]), sizes)
+    thin = norm(cross(e1, e2)) <= 1e-9 * longest[owner] * longest[owner]
+    flat = np.logical_or.reduceat(thin, starts)
+    reach = np.maximum.reduceat(norm(t - pts[p]).max(axis=1), starts)
+    return flat, reach
 
 
 def _insertions(pts, p: int, cand: list[int], tris, owner) -> list:
