@@ -742,7 +742,8 @@ def backtracking(
     prob = _Problem(cycles, e, n)
     centroid, flat = _cycle_geometry(pts, cycles)
     spread = np.linalg.norm(centroid - pts.mean(axis=0), axis=1)
-    rank = _rank(cycles, _cycle_area(pts, cycles, centroid), flat, spread)
+    area = _cycle_area(pts, cycles, centroid)
+    rank = _rank(cycles, area, flat, spread)
     folds = _fold_pairs(pts, e, prob.inc_edge, prob.inc_cycle, centroid, tolerance.fold_degrees)
     conflicts: dict[int, list[int]] = {}
     for a, b in folds:
@@ -826,6 +827,8 @@ def backtracking(
             prob.corner_next,
             e,
             n,
+            # areas in sixteenths of the median cycle's (integers for CP-SAT)
+            np.round(16.0 * area / max(float(np.median(area)), 1e-300)).astype(np.int64),
         )
         exact = exact_selection(
             incidence,

@@ -71,6 +71,13 @@ def ring_centres(points, faces) -> dict[int, int]:
     cen /= lengths[:, None]
     reach = np.zeros(len(faces))
     np.maximum.at(reach, owner, np.linalg.norm(pts[faces.vertices] - cen[owner], axis=1))
+    # best-fit plane normals of the faces a ring can be (length >= 4), one
+    # stacked SVD per length (the same LAPACK call per face as one by one)
+    normal = np.zeros((len(faces), 3))
+    for L in np.unique(lengths[lengths >= 4]).tolist():
+        ids = np.flatnonzero(lengths == L)
+        q = pts[faces.vertices[faces.offsets[ids][:, None] + np.arange(L)]] - cen[ids][:, None]
+        normal[ids] = np.linalg.svd(q, full_matrices=False)[2][:, -1]
     tree = cKDTree(cen)
     out: dict[int, int] = {}
     for p in strays.tolist():
@@ -78,11 +85,9 @@ def ring_centres(points, faces) -> dict[int, int]:
         for fi in np.atleast_1d(idx).tolist():
             if fi in out or lengths[fi] < 4:
                 continue
-            q = pts[faces.cycle(fi)] - cen[fi]
-            normal = np.linalg.svd(q, full_matrices=False)[2][-1]
             off = pts[p] - cen[fi]
-            across = abs(float(off @ normal))
-            within = float(np.linalg.norm(off - (off @ normal) * normal))
+            across = abs(float(off @ normal[fi]))
+            within = float(np.linalg.norm(off - (off @ normal[fi]) * normal[fi]))
             if within < reach[fi] and across < 2 * reach[fi]:
                 out[int(fi)] = int(p)
                 break

@@ -32,8 +32,14 @@ cycles fixed next to them), with the rest of the selection held fixed:
 The objective is lexicographic: open edges, then the negative Euler
 characteristic of the region (each handle costs 2; V counts used samples,
 so covering a sample with the same topology changes nothing), then stray
-samples, then the sides beyond three (smaller faces first, as the search's
-rank).  Maximising the Euler characteristic keeps the solver from buying
+samples, then the total area of the faces (``Incidence.cycle_cost``: each
+cycle's fan area in units of a sixteenth of the median cycle's).  Of the
+closed selections with the same coverage, the least area is the one that
+follows the surface: at an acute sharp edge, where the Euclidean RNG joins
+samples across the edge at every scan height, a stack of such "plates"
+closes the surface too, but folded like an accordion about a sample
+spacing deep; a smaller-faces-first tie-break chose the plates (they are
+triangles).  Maximising the Euler characteristic keeps the solver from buying
 coverage with handles.  It is solved in two phases from the same model:
 stray samples first without the Euler term (fast, and proven optimal on
 the library shapes), then with it, warm-started from the first answer.
@@ -94,6 +100,7 @@ class _Tables:
     corner_next: np.ndarray
     edge_of: dict  # (a, b) sorted -> edge id
     n_points: int
+    cost: np.ndarray  # per cycle: its quantized area, the objective's last term
 
     def cycles_at_edge(self, e: int) -> np.ndarray:
         ec = self.edge_cycles
@@ -118,6 +125,8 @@ class Incidence:
         The graph's edges (sorted rows), indexed by the edge ids.
     n_points : int
         Number of samples.
+    cycle_cost : (c,) int64
+        Every cycle's area, quantized (the objective's last term).
     """
 
     cycle_edge_ids: list
@@ -128,6 +137,7 @@ class Incidence:
     corner_next: np.ndarray
     edges: np.ndarray
     n_points: int
+    cycle_cost: np.ndarray
 
 
 def _tables(inc: Incidence) -> _Tables:
@@ -155,6 +165,7 @@ def _tables(inc: Incidence) -> _Tables:
         inc.corner_next,
         edge_of,
         inc.n_points,
+        np.asarray(inc.cycle_cost, dtype=np.int64),
     )
 
 
@@ -165,7 +176,7 @@ class _Score:
     open_lone: int
     minus_chi: int
     strays: int
-    sides: int
+    area: int
 
     def better_than(self, old: _Score, closed: bool) -> bool:
         """The order of the model's objective (closed or open)."""
@@ -174,18 +185,18 @@ class _Score:
         if old.over or (closed and old.open):
             return True
         if closed:
-            return (self.minus_chi, self.strays, self.sides) < (
+            return (self.minus_chi, self.strays, self.area) < (
                 old.minus_chi,
                 old.strays,
-                old.sides,
+                old.area,
             )
-        key = (self.open + self.strays, self.open_lone, self.sides)
-        return key < (old.open + old.strays, old.open_lone, old.sides)
+        key = (self.open + self.strays, self.open_lone, self.area)
+        return key < (old.open + old.strays, old.open_lone, old.area)
 
 
 def _score(tab: _Tables, state: np.ndarray, cycles, edges_, verts, lone) -> _Score:
     """(overloaded, open, open true-boundary edges, -Euler characteristic,
-    strays, sides beyond three) of ``state`` over a region: the model's
+    strays, quantized area) of ``state`` over a region: the model's
     objective, lexicographic."""
     use = {}
     for e in edges_:
@@ -200,8 +211,8 @@ def _score(tab: _Tables, state: np.ndarray, cycles, edges_, verts, lone) -> _Sco
             cov += 1
     faces = sum(1 for c in cycles if state[c] == 1)
     chi = cov - used_e + faces
-    sides = sum(len(tab.cycle_edges[c]) - 3 for c in cycles if state[c] == 1)
-    return _Score(over, open_, open_lone, -chi, len(verts) - cov, sides)
+    area = sum(int(tab.cost[c]) for c in cycles if state[c] == 1)
+    return _Score(over, open_, open_lone, -chi, len(verts) - cov, area)
 
 
 def _link_ok(tab: _Tables, state: np.ndarray, v: int) -> bool:
@@ -346,27 +357,25 @@ def _solve_component(
         m.AddBoolOr(mine + [cv.Not()])
         cov[v] = cv
     # objective, lexicographic by weights.  Closed model: -chi (when asked),
-    # then strays, then sides beyond three.  Open model (no closed answer):
+    # then strays, then area.  Open model (no closed answer):
     # open edges and strays together (a hole and a lost sample weigh the
     # same; removing faces to avoid an open edge loses their samples), then
-    # open true-boundary edges, then sides.
+    # open true-boundary edges, then area.
     nv, ne = len(verts), len(edges_)
-    extra = {c: len(tab.cycle_edges[c]) - 3 for c in cycles}  # sides beyond three
+    cost = {c: int(tab.cost[c]) for c in cycles}
     strays = [1 - cov[v] if isinstance(cov[v], int) else cov[v].Not() for v in verts]
-    sides = sum(extra[c] * x[c] for c in cycles)
-    w_stray = 1 + sum(extra.values())
+    area = sum(cost[c] * x[c] for c in cycles)
+    w_stray = 1 + sum(cost.values())
     if allow_open:
         open_bad = [o[e] for e in edges_ if e in o and e not in lone]
         open_lone = [o[e] for e in edges_ if e in o and e in lone]
         w_main = w_stray * (ne + 1)
-        obj = w_main * (sum(open_bad) + sum(strays)) + w_stray * sum(open_lone) + sides
+        obj = w_main * (sum(open_bad) + sum(strays)) + w_stray * sum(open_lone) + area
     else:
         w_chi = w_stray * (nv + 1) if chi else 0
         chi_terms = [cov[v] for v in verts]
         used = [y[e] for e in edges_]
-        obj = (
-            -w_chi * (sum(chi_terms) - sum(used) + sum(x.values())) + w_stray * sum(strays) + sides
-        )
+        obj = -w_chi * (sum(chi_terms) - sum(used) + sum(x.values())) + w_stray * sum(strays) + area
     m.Minimize(obj)
 
     def add_link(v: int) -> None:

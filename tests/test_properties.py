@@ -120,28 +120,12 @@ def _default_sampling(name):
     return _DEFAULT_SAMPLINGS[name]
 
 
-# a known failure, kept as a named regression: under the rotation the
-# derandomized profile draws first, the selection of star_prism (40 degree
-# edges) steps across an acute edge (horizontal 3-cycle faces join
-# neighbouring columns of samples at every scan height), so the surface
-# strays 1.07 h from the truth; homeomorphic, no crossing, every sample
-# used.  Whether it shows depends on the last bits of the working
-# coordinates (pyramid, 45 degrees, showed it, 1.03 h, while the working
-# frame was shifted to a sample; issue 22): the selection at acute edges is
-# on a knife edge
-_STEPS = pytest.mark.xfail(
-    reason="rotated: the surface steps across an acute edge, Hausdorff 1.07 h (issue 21)",
-    strict=True,
-)
-
-
 @pytest.mark.parametrize(
     "name",
     [
         pytest.param(
             n,
-            marks=([] if n in _QUICK_MOTION else [pytest.mark.slow])
-            + ([_STEPS] if n == "star_prism" else []),
+            marks=[] if n in _QUICK_MOTION else [pytest.mark.slow],
         )
         for n in shapes.shape_names()
     ],
