@@ -127,7 +127,7 @@ class FaceSelection:
     assignments: int
     non_disk_neighbourhoods: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64))
     notes: tuple[str, ...] = field(default=())
-    exact: ExactReport = field(default_factory=lambda: ExactReport(0, 0, 0, 0))
+    exact: ExactReport = field(default_factory=ExactReport)
     true_boundary: np.ndarray = field(default_factory=lambda: np.empty(0, bool))
 
 
@@ -805,7 +805,7 @@ def backtracking(
     finally:
         sys.setrecursionlimit(old_limit)
 
-    exact = ExactReport(0, 0, 0, 0)
+    exact = ExactReport()
     lone_edge = prob.n_cycles_at_edge == 1
     if failed and exact_seconds > 0:
         region = _region(prob, failed, lone_edge, n)

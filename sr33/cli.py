@@ -80,7 +80,19 @@ def _cmd_reconstruct(args) -> int:
         ("success condition", "met" if r.success else "NOT met"),
         ("unresolved samples", str(r.unresolved_samples.shape[0])),
         ("coned samples", str(r.coned_samples.shape[0])),
+        (
+            "strict search failed",
+            f"{r.fallback_components} component{'' if r.fallback_components == 1 else 's'}",
+        ),
     ]
+    if r.exact.components:
+        e = r.exact
+        rows += [
+            (
+                "exact selection",
+                f"{e.improved} of {e.components} improved, {e.proven} proven optimal",
+            )
+        ]
     rows += [(f"seconds {s}", f"{r.timings.get(s, 0.0):.3f}") for s in STEPS]
     rows += [("seconds total", f"{sum(r.timings.values()):.3f}"), ("output", str(out))]
     print(_table(rows))
@@ -93,6 +105,10 @@ def _cmd_reconstruct(args) -> int:
             "success": r.success,
             "unresolved_samples": int(r.unresolved_samples.shape[0]),
             "coned_samples": int(r.coned_samples.shape[0]),
+            "fallback_components": r.fallback_components,
+            "exact_selection": dict(
+                zip(("components", "improved", "proven", "cuts"), r.exact.as_tuple())
+            ),
             "stats": stats.as_dict(),
             "seconds": r.timings,
         }

@@ -512,6 +512,8 @@ def save_reconstruction(path, rec) -> Path:
                 int(rec.orientable),
                 rec.fallback_components,
                 rec.k,
+                rec.hole_faces,
+                *rec.exact.as_tuple(),
             ],
             dtype=np.int64,
         ),
@@ -528,6 +530,7 @@ def load_reconstruction(path):
     """Read a reconstruction written by :func:`save_reconstruction`."""
     from .cycles import CycleSet
     from .reconstruct import Reconstruction
+    from .selection import ExactReport
 
     p = Path(path)
     if not p.exists():
@@ -552,6 +555,9 @@ def load_reconstruction(path):
                 non_disk_neighbourhoods=z["non_disk_neighbourhoods"],
                 coned_samples=z["coned_samples"],
                 fallback_components=int(s[4]),
+                # files of earlier versions end after k
+                hole_faces=int(s[6]) if s.shape[0] > 6 else 0,
+                exact=ExactReport(*(int(x) for x in s[7:11])) if s.shape[0] > 10 else ExactReport(),
                 timings=dict(zip(z["timing_names"].tolist(), z["timing_values"].tolist())),
                 k=int(s[5]),
             )

@@ -25,6 +25,7 @@ from .holes import HoleLoops, concat, crossing_faces, face_links, hole_loops, un
 from .mesh import edge_keys, self_intersections
 from .progress import Steps, log, notice
 from .rng import localized_rng
+from .selection import ExactReport
 from .selfcheck import check_faces_and_triangles, strict_default
 from .tolerance import DEFAULT, Tolerance
 from .triangulate import triangulate
@@ -74,6 +75,11 @@ class Reconstruction:
     hole_faces : int
         Boundary loops of the selection closed by one face each
         (:mod:`sr33.holes`); they are the last cycles of ``face_cycles``.
+    exact : ExactReport
+        What the exact selection did where the strict search failed:
+        components solved, answers taken (strictly better than the greedy
+        one), answers proven optimal (the rest are the best found within
+        the budget), lazy cuts.
     timings : dict[str, float]
         Seconds per step.
     k : int
@@ -95,6 +101,7 @@ class Reconstruction:
     coned_samples: np.ndarray
     fallback_components: int
     hole_faces: int = 0
+    exact: ExactReport = field(default_factory=ExactReport)
     timings: dict[str, float] = field(default_factory=dict)
     k: int = 33
 
@@ -564,6 +571,7 @@ def reconstruct(
         coned_samples=np.sort(relabel[np.r_[coned, list(centres.values())].astype(np.int64)]),
         fallback_components=sel.fallback_components,
         hole_faces=n_loops,
+        exact=sel.exact,
         timings=timings,
         k=k,
     )

@@ -81,10 +81,14 @@ class ExactReport:
         Lazy constraints added (vertex links and bubbles).
     """
 
-    components: int
-    improved: int
-    proven: int
-    cuts: int
+    components: int = 0
+    improved: int = 0
+    proven: int = 0
+    cuts: int = 0
+
+    def as_tuple(self) -> tuple[int, int, int, int]:
+        """(components, improved, proven, cuts)."""
+        return (self.components, self.improved, self.proven, self.cuts)
 
 
 @dataclass
@@ -545,7 +549,7 @@ def exact_selection(
     n_points = incidence.n_points
     region = np.unique(np.asarray(region, dtype=np.int64))
     if region.shape[0] == 0:
-        return ExactReport(0, 0, 0, 0)
+        return ExactReport()
     n_at_edge = np.diff(tab.edge_cycles.indptr)
     lone = set(np.flatnonzero(n_at_edge == 1).tolist())
     # components of the region through shared samples

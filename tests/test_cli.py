@@ -287,6 +287,9 @@ def test_reconstruct_exits_1_when_the_success_condition_fails(
     )
     assert code == 1
     assert re.search(r"^success condition +NOT met$", text, re.M)
+    # what the search could not decide, and what the exact selection made of it
+    assert re.search(r"^strict search failed +1 component$", text, re.M)
+    assert re.search(r"^exact selection +0 of 1 improved, 0 proven optimal$", text, re.M)
     assert out.exists()  # the result is still written
 
 
