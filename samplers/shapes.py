@@ -33,8 +33,12 @@ Examples
 from __future__ import annotations
 
 import math
+import os
+import sys
 from collections.abc import Callable
+from contextlib import contextmanager
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -87,7 +91,7 @@ class Shape:
     Attributes
     ----------
     name : str
-        Shape name, one of :func:`shape_names`.
+        Shape name: one of :func:`shape_names`, or a CAD model's (:func:`from_cad`).
     solid : cadquery.Solid or cadquery.Shell
         The CadQuery object (a solid, or an open shell for ``L_sheet``).
     params : dict of str to float
@@ -933,19 +937,25 @@ def build(name: str, **params: float) -> Shape:
 
     if not BRepCheck_Analyzer(solid.wrapped).IsValid():
         raise ShapeError(f"CadQuery built an invalid {name} for {p}")
+    return _shape_of(name, solid, p, f"{name} for {p}")
+
+
+def _shape_of(name: str, solid, params: dict[str, float], what: str) -> Shape:
+    """The :class:`Shape` record of a valid solid: its B-rep topology, truth
+    mesh, size, area and default spacing."""
     expected = brep_topology(solid)
     size = _exact_size(solid)
     vertices, triangles = _truth_mesh(solid, size)
     problem = _mesh_problem(triangles, expected)
     if problem is not None:
-        raise ShapeError(f"the truth mesh of {name} for {p} does not fit its B-rep: {problem}")
+        raise ShapeError(f"the truth mesh of {what} does not fit its B-rep: {problem}")
     vertices.setflags(write=False)
     triangles.setflags(write=False)
     area = float(solid.Area())
     return Shape(
         name=name,
         solid=solid,
-        params=p,
+        params=params,
         expected=expected,
         truth_vertices=vertices,
         truth_triangles=triangles,
@@ -953,3 +963,100 @@ def build(name: str, **params: float) -> Shape:
         default_spacing=_nice(math.sqrt(area / TARGET_SAMPLES)),
         area=area,
     )
+
+
+CAD_FORMATS = (".step", ".stp", ".brep")
+
+
+@contextmanager
+def _silenced():
+    """Silence what C++ code prints (OpenCascade's STEP reader reports parse
+    errors on stdout itself): file descriptors 1 and 2 go to the null device
+    for the block; the caller turns failures into one-line errors."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    null = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 1)
+        os.dup2(null, 2)
+        yield
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in saved + [null]:
+            os.close(fd)
+
+
+def _read_cad(path: Path):
+    """The CadQuery shape in a STEP or BREP file."""
+    import cadquery as cq
+
+    ext = path.suffix.lower()
+    if ext not in CAD_FORMATS:
+        raise ShapeError(
+            f"{path}: unsupported CAD format {ext or '(none)'}; use one of {', '.join(CAD_FORMATS)}"
+        )
+    if not path.is_file():
+        raise ShapeError(f"{path}: no such file")
+    try:
+        with _silenced():
+            if ext == ".brep":
+                return cq.Shape.importBrep(str(path))
+            return cq.importers.importStep(str(path)).val()
+    except Exception as exc:  # OCC reader failures: ValueError, Standard_Failure...
+        msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ShapeError(f"{path}: unreadable {ext} file ({msg})") from None
+
+
+def from_cad(source, name: str | None = None) -> Shape:
+    """A user's CAD model as a :class:`Shape`: its B-rep topology, ground
+    truth mesh and default spacing, as :func:`build` gives for the library.
+
+    Parameters
+    ----------
+    source : cadquery.Workplane, cadquery.Shape, str or path
+        A CadQuery object (a Workplane's first solid is taken) or a STEP
+        (``.step``/``.stp``) or BREP (``.brep``) file.
+    name : str, optional
+        The name the record carries (default: the file's stem, or ``"cad"``).
+
+    Returns
+    -------
+    Shape
+        ``params`` is empty.
+
+    Raises
+    ------
+    ShapeError
+        An unreadable or unsupported file, a model that is not one solid or
+        shell, an invalid B-rep, or a tessellation that does not fit it.
+    """
+    import cadquery as cq
+
+    if isinstance(source, (str, Path)):
+        path = Path(source)
+        obj = _read_cad(path)
+        label = name or path.stem
+        what = str(path)
+    else:
+        obj = source.val() if isinstance(source, cq.Workplane) else source
+        label = name or "cad"
+        what = f"the {type(obj).__name__}"
+    if not isinstance(obj, cq.Shape):
+        raise ShapeError(f"{what}: not a CadQuery shape (got {type(obj).__name__})")
+    solids, shells = obj.Solids(), obj.Shells()
+    if len(solids) == 1:
+        solid = cq.Solid(solids[0].wrapped)
+    elif not solids and len(shells) == 1:
+        solid = cq.Shell(shells[0].wrapped)
+    else:
+        raise ShapeError(
+            f"{what}: holds {len(solids)} solids and {len(shells)} shells; "
+            "sampling needs one solid (or one open shell)"
+        )
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    if not BRepCheck_Analyzer(solid.wrapped).IsValid():
+        raise ShapeError(f"{what}: the B-rep is invalid (OpenCascade's check fails)")
+    return _shape_of(label, solid, {}, what)

@@ -170,7 +170,18 @@ def _cmd_sample(args) -> int:
             print(f"{'':<16} parameters: {defaults}")
         return 0
     if not args.shape:
-        raise InputError("sample needs a SHAPE name (see sr33 sample --list)")
+        raise InputError(
+            "sample needs a SHAPE: a library name (see sr33 sample --list) or a STEP/BREP file"
+        )
+    suffix = Path(args.shape).suffix.lower()
+    from_file = suffix in shapes.CAD_FORMATS
+    if suffix and not from_file:
+        raise InputError(
+            f"{args.shape}: unsupported CAD format {suffix}; use one of "
+            f"{', '.join(shapes.CAD_FORMATS)} (or a library shape name, see sr33 sample --list)"
+        )
+    if from_file and args.param:
+        raise InputError(f"--param applies to library shapes, not to the CAD file {args.shape}")
     if not args.output:
         raise InputError("sample needs -o/--output for the points")
     from .io import MESH_FORMATS, POINT_FORMATS, TEXT_FORMATS, write_mesh, write_points
@@ -181,11 +192,14 @@ def _cmd_sample(args) -> int:
             (args.truth, MESH_FORMATS, "truth mesh"),
             (args.meta, TEXT_FORMATS, "text"),
         ],
-        inputs=[],
+        inputs=[args.shape] if from_file else [],
     )
 
     try:
-        shape = shapes.build(args.shape, **_parse_params(args.param))
+        if from_file:
+            shape = shapes.from_cad(args.shape)
+        else:
+            shape = shapes.build(args.shape, **_parse_params(args.param))
         res = scanline.scan(
             shape,
             args.spacing,
@@ -213,7 +227,7 @@ def _cmd_sample(args) -> int:
     exp = shape.expected
     rows = [
         ("shape", shape.name),
-        ("parameters", ", ".join(f"{k}={v:g}" for k, v in shape.params.items())),
+        ("parameters", ", ".join(f"{k}={v:g}" for k, v in shape.params.items()) or "-"),
         ("spacing h", f"{res.meta['spacing']:.6g}"),
         ("ratio r", f"{res.meta['ratio']:g}"),
         ("points", str(res.points.shape[0])),
@@ -434,7 +448,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     r.set_defaults(func=_cmd_reconstruct)
     sm = add("sample", "scan-line samples of a sharp CAD shape")
-    sm.add_argument("shape", nargs="?", help="shape name (see --list)")
+    sm.add_argument(
+        "shape", nargs="?", help="a library shape name (see --list) or a .step/.stp/.brep file"
+    )
     sm.add_argument("--list", action="store_true", help="list shapes and their parameters")
     sm.add_argument("--param", action="append", default=[], metavar="KEY=VALUE")
     sm.add_argument("--spacing", type=float, help="scan-line spacing h (default: per shape)")

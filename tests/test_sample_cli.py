@@ -116,3 +116,107 @@ def test_no_repair_keeps_the_plain_scan_rows(tmp_path):
     plain = scan(shapes.build("cylinder"), 0.1, repair=False)
     np.testing.assert_allclose(read_points(out), plain.points, rtol=0, atol=1e-12)
     assert plain.meta["repairs"] == []
+
+
+# --- a user's CAD file (issue 23 item 1) -----------------------------------
+
+
+def _part():
+    """A part with two through-holes, filleted vertical edges and a
+    chamfered top: genus 2, planar, cylindrical and conical faces."""
+    import cadquery as cq
+
+    return (
+        cq.Workplane("XY")
+        .box(1.0, 0.7, 0.3)
+        .edges("|Z")
+        .fillet(0.1)
+        .faces(">Z")
+        .edges()
+        .chamfer(0.04)
+        .faces(">Z")
+        .workplane()
+        .pushPoints([(-0.25, 0), (0.25, 0)])
+        .hole(0.18)
+    )
+
+
+def test_a_step_file_is_sampled_on_its_surface_and_reconstructs(tmp_path, capsys):
+    import cadquery as cq
+
+    from sr33 import reconstruct
+    from sr33.validators.fidelity import distance_to_surface
+    from sr33.validators.intersections import self_intersections
+    from sr33.validators.signature import homeomorphic, signature
+
+    step = tmp_path / "part.step"
+    cq.exporters.export(_part(), str(step))
+    pts, truth, meta = tmp_path / "p.ply", tmp_path / "t.ply", tmp_path / "m.json"
+    argv = ["sample", str(step), "--no-repair", "--points", "2000", "-q"]
+    argv += ["-o", str(pts), "--truth", str(truth), "--meta", str(meta)]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "expected topology  components 1, Euler -2, genus 2, boundary loops 0" in out
+    doc = json.loads(meta.read_text())
+    assert doc["shape"] == "part" and doc["params"] == {}
+    p = read_points(pts)
+    tv, tf = read_mesh(truth)
+    # on the CAD surface (the truth is its tessellation, 1/500 of the size)
+    assert distance_to_surface(p, tv, tf).max() < 1e-3
+    r = reconstruct(p, 33)
+    sig = signature(r.triangles, r.vertices.shape[0], points=r.vertices)
+    assert homeomorphic(sig, signature(tf, tv.shape[0]))
+    assert self_intersections(r.vertices, r.triangles).shape[0] == 0
+
+
+def test_from_cad_reads_cadquery_objects_and_brep_files(tmp_path):
+    import cadquery as cq
+
+    from sr33.samplers import shapes
+
+    direct = shapes.from_cad(_part())
+    assert direct.name == "cad" and direct.expected.genus == 2
+    brep = tmp_path / "part.brep"
+    _part().val().exportBrep(str(brep))
+    read = shapes.from_cad(brep)
+    assert read.name == "part" and read.expected == direct.expected
+    assert read.area == pytest.approx(direct.area, rel=1e-9)
+    box = shapes.from_cad(cq.Workplane().box(1, 2, 3), name="brick")
+    assert (box.name, box.expected.euler, box.expected.genus) == ("brick", 2, 0)
+    assert box.area == pytest.approx(22.0)
+
+
+@pytest.mark.parametrize(
+    "case, message",
+    [
+        ("missing", "missing.step: no such file"),
+        ("garbage", "garbage.step: unreadable .step file"),
+        ("two", "two.step: holds 2 solids"),
+        ("iges", "part.iges: unsupported CAD format .iges; use one of .step, .stp, .brep"),
+        ("param", "--param applies to library shapes, not to the CAD file"),
+    ],
+)
+def test_bad_cad_files_are_one_line_errors(tmp_path, capfd, case, message):
+    import cadquery as cq
+
+    argv = ["sample"]
+    if case == "missing":
+        argv.append(str(tmp_path / "missing.step"))
+    elif case == "garbage":
+        (tmp_path / "garbage.step").write_text("not a STEP file\n")
+        argv.append(str(tmp_path / "garbage.step"))
+    elif case == "two":
+        two = cq.Workplane().box(1, 1, 1).union(cq.Workplane().box(1, 1, 1).translate((3, 0, 0)))
+        cq.exporters.export(two, str(tmp_path / "two.step"))
+        argv.append(str(tmp_path / "two.step"))
+    elif case == "iges":
+        argv.append(str(tmp_path / "part.iges"))
+    else:
+        cq.exporters.export(_part(), str(tmp_path / "part.step"))
+        argv += [str(tmp_path / "part.step"), "--param", "side=2"]
+    assert main(argv + ["-o", str(tmp_path / "p.ply")]) == 2
+    captured = capfd.readouterr()  # the file descriptors: OpenCascade writes to them
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and message in err[0], err
+    assert "StepFile" not in captured.out  # OpenCascade's own report is silenced
+    assert not (tmp_path / "p.ply").exists()
