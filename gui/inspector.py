@@ -28,7 +28,7 @@ from sr33.cycles import CycleSet, trivial_isometric_cycles
 from sr33.mesh import as_mesh
 from sr33.reconstruct import Reconstruction, reconstruct
 from sr33.rng import k_neighbourhoods
-from sr33.validators.conditions import local_delaunay
+from sr33.validators.conditions import condition_iii
 from sr33.validators.signature import signature
 from sr33.validators.topology import edge_uses, mesh_stats
 
@@ -192,6 +192,7 @@ class Inspector:
         self.truth = truth
         self.compare = compare
         self.state = InspectorState(k=int(k))
+        self._condition = None  # Condition III of the samples, computed once
         if truth is not None:
             self.state.layers["truth"] = True
         self.rec: Reconstruction = (
@@ -226,12 +227,19 @@ class Inspector:
         used = np.zeros(n, dtype=bool)
         used[rec.triangles.ravel()] = True
         self.unused = np.flatnonzero(~used)
-        self.conditions = local_delaunay(v).violations() if n > 13 else np.empty(0, np.int64)
+        # one Condition III verdict for the project: geodesic on the truth
+        # when there is one (what `sr33 conditions` says), else approximate
+        if self._condition is None:
+            truth = self.truth if self.truth is not None else (None, None)
+            self._condition = condition_iii(v, *truth, quiet=False)
+        self.conditions = self._condition.violations
         st = mesh_stats(rec.triangles, n).as_dict()
         st.update(
             nonmanifold_vertices=int(self.nonmanifold.shape[0]),
             unused_samples=int(self.unused.shape[0]),
             condition_violations=int(self.conditions.shape[0]),
+            condition_method=self._condition.method,
+            condition_worst_ratio=float(self._condition.max_ratio),
             success=bool(rec.success),
             reconstructed=bool(rec.k),
         )
@@ -341,7 +349,8 @@ class Inspector:
             f"open {f.get('open_edges')}  overloaded {f.get('overloaded_edges')}  "
             f"Euler {f.get('euler')}  components {f.get('components')}",
             f"non-manifold {f.get('nonmanifold_vertices')}  unused {f.get('unused_samples')}  "
-            f"condition III violations {f.get('condition_violations')}",
+            f"condition III violations {f.get('condition_violations')} "
+            f"({f.get('condition_method')})",
             verdict,
         ]
         if self.state.message:

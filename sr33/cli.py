@@ -303,6 +303,22 @@ def _cmd_validate(args) -> int:
         doc["homeomorphic"] = bool(verdict)
         doc["reasons"] = list(verdict.reasons)
         doc["hausdorff_h"] = fid.hausdorff_h
+    if args.points:
+        # the samples' Condition III: geodesic on the truth when there is one
+        # (the verdict of `sr33 conditions`), else approximate; reported, not
+        # part of the mesh's check
+        from sr33.validators.conditions import condition_iii
+
+        truth = read_mesh(args.truth) if args.truth else (None, None)
+        cond = condition_iii(pts, *truth, quiet=args.quiet)
+        rows.append(("points' Condition III", cond.line()))
+        doc["condition_iii"] = {
+            "method": cond.method,
+            "passed": cond.passed,
+            "violating_samples": int(cond.violations.shape[0]),
+            "worst_ratio": cond.max_ratio,
+            "max_degree": cond.max_degree,
+        }
     print(_table(rows))
     doc["ok"] = bool(ok)
     if args.json:
@@ -472,8 +488,13 @@ def build_parser() -> argparse.ArgumentParser:
     va = add("validate", "topology, defects and fidelity of a mesh")
     va.add_argument("mesh")
     va.add_argument("--truth", help="ground-truth mesh: homeomorphism and Hausdorff distance")
-    va.add_argument("--points", help="the input samples: are they all vertices?")
+    va.add_argument(
+        "--points",
+        help="the input samples: are they all vertices, and their Condition III "
+        "(geodesic with --truth, else approximate)",
+    )
     va.add_argument("--json", help="also write the report as JSON here")
+    va.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     va.set_defaults(func=_cmd_validate)
     co = add("conditions", "measure the paper's sample conditions")
     co.add_argument("points")

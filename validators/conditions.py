@@ -169,6 +169,18 @@ class ConditionReport:
             "III-ii ratio": np.argsort(-r, kind="stable")[:count].tolist(),
         }
 
+    @property
+    def ratio_limit(self) -> float:
+        """Condition III-ii's bound √3/2 (1 − ε), ε = 0 where not measured."""
+        eps = self.epsilon if np.isfinite(self.epsilon) else 0.0
+        return SQRT3_2 * (1 - eps)
+
+    def violations(self) -> np.ndarray:
+        """Samples breaking III-i (degree above 33) or III-ii (a DT_M triangle
+        at or above :attr:`ratio_limit`), sorted."""
+        bad = (self.degree > 33) | (self.worst_ratio >= self.ratio_limit)
+        return np.flatnonzero(bad)
+
     def _ii_iv_row(self) -> tuple[str, str, str, str]:
         name = "II-iv  non-trivial cycles > 33k"
         if self.truth_genus and all(g == 0 for g in self.truth_genus):
@@ -180,9 +192,8 @@ class ConditionReport:
         w = self.worst(5)
         off = float(self.off_truth.max()) if self.off_truth.size else 0.0
         ratio = self.max_ratio
-        eps = self.epsilon if np.isfinite(self.epsilon) else 0.0
         if np.isfinite(ratio):
-            ii = ("pass" if ratio < SQRT3_2 * (1 - eps) else "FAIL", f"{ratio:.4f}")
+            ii = ("pass" if ratio < self.ratio_limit else "FAIL", f"{ratio:.4f}")
         else:
             ii = ("not measured", "no DT_M triangle")
         return [
@@ -206,6 +217,78 @@ class ConditionReport:
                 str(w["on the truth"]),
             ),
         ]
+
+
+@dataclass(frozen=True)
+class ConditionIII:
+    """Condition III's verdict on a sampling, one for the whole project.
+
+    The geodesic measure (:func:`sample_conditions` on a truth) where a
+    truth is known, the approximate tangent-plane one (:func:`local_delaunay`)
+    where it is not; ``method`` says which, and every report shows it.
+
+    Attributes
+    ----------
+    method : str
+        ``"geodesic"`` or ``"approximate (no truth)"``.
+    violations : (v,) int64
+        Samples breaking III-i or III-ii, sorted.
+    max_ratio : float
+        Worst III-ii ratio (second-longest over longest edge); NaN when no
+        triangle was measured.
+    max_degree : int
+        Largest DT_M degree (III-i).
+    passed : bool
+        III-i and III-ii hold at every sample (for the geodesic method, the
+        verdict of ``sr33 conditions``' two Condition III rows).
+    """
+
+    method: str
+    violations: np.ndarray
+    max_ratio: float
+    max_degree: int
+    passed: bool
+
+    def line(self) -> str:
+        """One line for a report."""
+        if not np.isfinite(self.max_ratio) and self.max_degree == 0:
+            return f"not measured: too few samples for a triangle ({self.method})"
+        ratio = "n/a" if not np.isfinite(self.max_ratio) else f"{self.max_ratio:.4f}"
+        return (
+            f"{'pass' if self.passed else 'FAIL'}: {self.violations.shape[0]} samples violate, "
+            f"worst III-ii ratio {ratio}, max degree {self.max_degree} ({self.method})"
+        )
+
+
+def condition_iii(
+    points, truth_vertices=None, truth_triangles=None, *, quiet: bool = True
+) -> ConditionIII:
+    """Condition III (Section 3) of ``points``: geodesic on the truth when one
+    is given (:func:`sample_conditions`), else the approximate local check
+    (:func:`local_delaunay`; tangent planes of 12 neighbours, which misreads
+    samples at sharp edges).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> g = np.stack(np.meshgrid(np.arange(6.0), np.arange(6.0), [0.0]), -1).reshape(-1, 3)
+    >>> c = condition_iii(g + np.random.default_rng(0).normal(0, 1e-3, g.shape))
+    >>> c.method
+    'approximate (no truth)'
+    """
+    if truth_vertices is not None:
+        rep = sample_conditions(points, truth_vertices, truth_triangles, quiet=quiet)
+        ratio = rep.max_ratio
+        ok = rep.max_degree <= 33 and (not np.isfinite(ratio) or ratio < rep.ratio_limit)
+        return ConditionIII("geodesic", rep.violations(), ratio, rep.max_degree, bool(ok))
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.shape[0] <= 13:
+        return ConditionIII("approximate (no truth)", np.empty(0, np.int64), float("nan"), 0, True)
+    ld = local_delaunay(pts)
+    bad = ld.violations()
+    return ConditionIII(
+        "approximate (no truth)", bad, ld.max_ratio, ld.max_degree, bad.shape[0] == 0
+    )
 
 
 class _Geodesics:
