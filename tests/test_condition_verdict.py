@@ -57,7 +57,7 @@ def test_inspector_and_validate_report_the_verdict_of_conditions(box_hole_rows, 
     line = [
         r for r in capsys.readouterr().out.splitlines() if r.startswith("points' Condition III")
     ]
-    assert len(line) == 1 and line[0].split(None, 2)[2] == (
+    assert len(line) == 1 and line[0].split(None, 3)[3] == (
         f"FAIL: {bad.shape[0]} samples violate, worst III-ii ratio "
         f"{report.max_ratio:.4f}, max degree {report.max_degree} (geodesic)"
     )
