@@ -114,7 +114,7 @@ def test_conditions_on_three_points_does_not_fail_on_nan():
     rep = sample_conditions(TETRA[:3] * 0.9 + 0.03, TETRA, FACES)
     rows = {r[0][:6]: r for r in rep.table()}
     assert np.isnan(rep.epsilon)
-    assert rows["III-ii"][1:3] == ("pass", "0.7501")
+    assert rows["III-ii"][1] == "pass" and 0.7 < float(rows["III-ii"][2]) < 0.8
     assert all(r[1] != "FAIL" for r in rows.values())
 
 
