@@ -72,7 +72,7 @@ def test_a_coarse_truth_is_refined_and_gives_the_same_answer(plane):
 
 def test_unreachable_resolution_is_an_error(plane):
     p = np.array([[0, 0, 0], [1e-5, 0, 0], [0.2, 0.2, 0]], float)
-    with pytest.raises(ValueError, match="refining the truth mesh to edges of 2e-06 needs more"):
+    with pytest.raises(ValueError, match="refining the truth mesh to edges of 3.33e-06 needs more"):
         sample_conditions(p, *plane)
 
 

@@ -309,9 +309,9 @@ class _Geodesics:
     truth refined to edges of one spacing and the samples inserted as
     vertices.  Refining splits the truth's triangles in their planes, so the
     surface, and its geodesics, are the same at any resolution; the labels'
-    mesh (a fifth of a spacing) is 25 times larger, and the solver's set-up
+    mesh (a third of a spacing) is 9 times larger, and the solver's set-up
     and paths grow with it (a block with two holes: 20 s and 64 ms a path
-    there, 0.5 s and 1.6 ms here).
+    on a mesh of a fifth of a spacing, 0.5 s and 1.6 ms here).
     """
 
     def __init__(self, pts, surface, spacing: float, quiet: bool = True):
@@ -551,9 +551,10 @@ def _settle(pts, tv, tf, snap, orphans, dt, resolution, sharp_degrees):
 
 
 # a DT_M edge whose two cells meet along at most this many truth edges (at the
-# default resolution, a fifth of the spacing) is a near tie: its four samples
-# lie within about the resolution of one circle, so the labels may have taken
-# the wrong diagonal
+# default resolution, a third of the spacing: two spacings of boundary) is a
+# near tie: its four samples lie within about the resolution of one circle,
+# so the labels may have taken the wrong diagonal, and the angle test on
+# geodesic lengths decides it
 TIE_CROSSINGS = 6
 FLIP_MARGIN = 5.0  # degrees: any other DT_M edge this far from Delaunay is the labels' error
 
@@ -686,8 +687,9 @@ def sample_conditions(
     sharp_degrees : float
         Dihedral angle above which a truth edge counts as sharp.
     resolution : float, optional
-        Longest truth edge after refinement; default a fifth of the samples'
-        median nearest-neighbour distance.
+        Longest truth edge after refinement; default a third of the samples'
+        median nearest-neighbour distance (a fifth gave the same figures on
+        every library shape, 2-4 times slower).
     flip_ties : bool
         Decide near ties (four samples within about the resolution of one
         circle), and edges plainly not Delaunay, by the intrinsic Delaunay
@@ -732,7 +734,7 @@ def sample_conditions(
             "truth in the same frame and units?"
         )
     if resolution is None:
-        resolution = spacing / 5.0
+        resolution = spacing / 3.0
     if not (np.isfinite(resolution) and resolution > 0):
         raise ValueError(f"resolution must be a positive length, got {resolution}")
     genus = tuple(c.genus for c in signature(of, ov.shape[0]).components)
