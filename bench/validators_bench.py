@@ -3,7 +3,9 @@
 - topology (``sr33.validators.signature`` and ``mesh_stats``) of a 1,000,000-triangle
   torus mesh;
 - sample conditions (``sr33.validators.sample_conditions``) for 10,000 samples on
-  a sphere whose truth mesh has 163,842 vertices.
+  a sphere whose truth mesh has 163,842 vertices, and for the default
+  sampling of the library's cutcube (about 7,500 samples on planes, a
+  cylinder and a sphere; issue 23 asks for 6,000 samples in at most 30 s).
 
 Median of ``--repeats`` runs.  Run: ``.venv/bin/python bench/validators_bench.py``.
 """
@@ -19,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # the tests' mesh generators
 
 from sr33.validators import mesh_stats  # noqa: E402
 from sr33.validators.conditions import sample_conditions  # noqa: E402
@@ -55,6 +58,16 @@ def main(argv=None) -> int:
     q = np.stack([np.cos(th) * np.sin(phi), np.sin(th) * np.sin(phi), np.cos(phi)], 1)
     t = timed(lambda: sample_conditions(q, v, f), args.repeats)
     print(f"conditions, {n} samples on a {v.shape[0]}-vertex truth: {t:.2f} s")
+    try:
+        from sr33.samplers import shapes
+        from sr33.samplers.scanline import scan
+    except ImportError:  # pragma: no cover - CadQuery missing
+        return 0
+    shape = shapes.build("cutcube")
+    pts = scan(shape).points
+    tv, tf = shape.truth_vertices, shape.truth_triangles
+    t = timed(lambda: sample_conditions(pts, tv, tf), args.repeats)
+    print(f"conditions, cutcube's default sampling ({pts.shape[0]} samples): {t:.2f} s")
     return 0
 
 
