@@ -23,31 +23,31 @@ _FOLD = 1.0 - 1e-12  # cosine above which two triangles on one edge fold
 
 
 @njit(cache=True)
+def _diff(v, a, b):
+    """v[a] - v[b] as three scalars."""
+    return v[a, 0] - v[b, 0], v[a, 1] - v[b, 1], v[a, 2] - v[b, 2]
+
+
+@njit(cache=True)
+def _cross(ax, ay, az, bx, by, bz):
+    """(a x b), component by component (no fused multiply-add)."""
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+
+
+@njit(cache=True)
 def _segment_crosses(v, p0, p1, a, b, c, eps):
     """Does the open segment v[p0]-v[p1] cross triangle (a, b, c)?"""
-    dx = v[p1, 0] - v[p0, 0]
-    dy = v[p1, 1] - v[p0, 1]
-    dz = v[p1, 2] - v[p0, 2]
-    e1x = v[b, 0] - v[a, 0]
-    e1y = v[b, 1] - v[a, 1]
-    e1z = v[b, 2] - v[a, 2]
-    e2x = v[c, 0] - v[a, 0]
-    e2y = v[c, 1] - v[a, 1]
-    e2z = v[c, 2] - v[a, 2]
-    hx = dy * e2z - dz * e2y
-    hy = dz * e2x - dx * e2z
-    hz = dx * e2y - dy * e2x
+    dx, dy, dz = _diff(v, p1, p0)
+    e1x, e1y, e1z = _diff(v, b, a)
+    e2x, e2y, e2z = _diff(v, c, a)
+    hx, hy, hz = _cross(dx, dy, dz, e2x, e2y, e2z)
     det = e1x * hx + e1y * hy + e1z * hz
     if not abs(det) > eps:
         return False
     inv = 1.0 / det
-    sx = v[p0, 0] - v[a, 0]
-    sy = v[p0, 1] - v[a, 1]
-    sz = v[p0, 2] - v[a, 2]
+    sx, sy, sz = _diff(v, p0, a)
     u = inv * (sx * hx + sy * hy + sz * hz)
-    qx = sy * e1z - sz * e1y
-    qy = sz * e1x - sx * e1z
-    qz = sx * e1y - sy * e1x
+    qx, qy, qz = _cross(sx, sy, sz, e1x, e1y, e1z)
     w = inv * (dx * qx + dy * qy + dz * qz)
     t = inv * (e2x * qx + e2y * qy + e2z * qz)
     return u >= -_TOL and w >= -_TOL and u + w <= 1.0 + _TOL and t > _TOL and t < 1.0 - _TOL
@@ -110,21 +110,9 @@ def triangles_meet(v, s, d, eps):
             ob = d[k]
     if oa < 0 or ob < 0 or e1 < 0:
         return False
-    ex = v[e1, 0] - v[e0, 0]
-    ey = v[e1, 1] - v[e0, 1]
-    ez = v[e1, 2] - v[e0, 2]
-    ax = v[oa, 0] - v[e0, 0]
-    ay = v[oa, 1] - v[e0, 1]
-    az = v[oa, 2] - v[e0, 2]
-    bx = v[ob, 0] - v[e0, 0]
-    by = v[ob, 1] - v[e0, 1]
-    bz = v[ob, 2] - v[e0, 2]
-    nax = ey * az - ez * ay
-    nay = ez * ax - ex * az
-    naz = ex * ay - ey * ax
-    nbx = ey * bz - ez * by
-    nby = ez * bx - ex * bz
-    nbz = ex * by - ey * bx
+    ex, ey, ez = _diff(v, e1, e0)
+    nax, nay, naz = _cross(ex, ey, ez, *_diff(v, oa, e0))
+    nbx, nby, nbz = _cross(ex, ey, ez, *_diff(v, ob, e0))
     la = np.sqrt(nax * nax + nay * nay + naz * naz)
     lb = np.sqrt(nbx * nbx + nby * nby + nbz * nbz)
     cos = (nax * nbx + nay * nby + naz * nbz) / max(la * lb, 1e-300)

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .mesh import as_coordinates
+
 
 class InputError(ValueError):
     """Bad input to sr33: the message says which argument and why."""
@@ -15,18 +17,9 @@ def as_points(points, name: str = "points") -> np.ndarray:
     if np.iscomplexobj(points):
         raise InputError(f"{name} must be real numbers, got a complex array")
     try:
-        arr = np.asarray(points, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be numeric, could not convert: {exc}") from None
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise InputError(f"{name} must have shape (n, 3), got {arr.shape}")
-    bad = ~np.isfinite(arr).all(axis=1)
-    if bad.any():
-        first = int(np.flatnonzero(bad)[0])
-        raise InputError(
-            f"{name} contain {int(bad.sum())} non-finite (NaN or inf) coordinates rows, "
-            f"first at row {first}"
-        )
+        arr = as_coordinates(points, name)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
     if arr.shape[0] < 4:
         raise InputError(f"{name} must hold at least 4 points, got {arr.shape[0]}")
     return np.ascontiguousarray(arr)

@@ -225,6 +225,35 @@ def as_triangles(triangles) -> np.ndarray:
     return tri.astype(np.int64)
 
 
+def as_coordinates(values, name: str = "points", item: str = "point") -> np.ndarray:
+    """``values`` as a float64 ``(n, 3)`` array of finite coordinates, or one
+    :class:`ValueError` naming ``name``, the rule and the first offender
+    (the one check of coordinates: points, vertices, truths).
+
+    Examples
+    --------
+    >>> as_coordinates([[0, 0], [1, 2]], "p")
+    Traceback (most recent call last):
+    ...
+    ValueError: p must have shape (n, 3), got (2, 2)
+    """
+    try:
+        v = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be numeric, could not convert: {exc}") from None
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (n, 3), got {v.shape}")
+    bad = ~np.isfinite(v).all(axis=1)
+    if bad.any():
+        first = int(np.flatnonzero(bad)[0])
+        plural = {"vertex": "vertices"}.get(item, item + "s")
+        raise ValueError(
+            f"{name}: {int(bad.sum())} of {v.shape[0]} {plural} have non-finite (NaN or inf) "
+            f"coordinates, first {item} {first} = {v[first].tolist()}"
+        )
+    return v
+
+
 def as_mesh(
     vertices, triangles, name: str = "mesh", item: str = "vertex"
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -242,20 +271,7 @@ def as_mesh(
     ...
     ValueError: mesh: triangle 0 uses vertex 3, out of range 0..2
     """
-    try:
-        v = np.asarray(vertices, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}: vertices must be numeric ({exc})") from None
-    if v.ndim != 2 or v.shape[1] != 3:
-        raise ValueError(f"{name}: vertices must have shape (n, 3), got {v.shape}")
-    bad = ~np.isfinite(v).all(axis=1)
-    if bad.any():
-        first = int(np.flatnonzero(bad)[0])
-        plural = {"vertex": "vertices"}.get(item, item + "s")
-        raise ValueError(
-            f"{name}: {int(bad.sum())} of {v.shape[0]} {plural} have non-finite (NaN or inf) "
-            f"coordinates, first {item} {first} = {v[first].tolist()}"
-        )
+    v = as_coordinates(vertices, name, item)
     tri = np.asarray(triangles)
     if tri.size and not np.issubdtype(tri.dtype, np.integer):
         raise ValueError(f"{name}: triangles must be integer indices, got dtype {tri.dtype}")

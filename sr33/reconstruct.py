@@ -363,6 +363,29 @@ def _compiling(quiet: bool):
     return notify
 
 
+@dataclass(frozen=True)
+class _Run:
+    """What the steps of one run computed, in the canonical order of the
+    distinct samples (see :func:`_pipeline`)."""
+
+    pts: np.ndarray  # the working (normalized) coordinates
+    uniq: np.ndarray  # the distinct samples as given
+    first: np.ndarray  # each one's first input row
+    inverse: np.ndarray  # each input row's distinct sample
+    duplicates: int
+    k: int
+    rng: object  # LocalizedRNG
+    cycles: CycleSet
+    selection: object  # FaceSelection
+    faces: CycleSet  # the selection's faces, loop faces after them
+    triangulation: object  # Triangulation of ``faces``
+    centres: dict
+    loops: int
+    figures: _Figures
+    triangles: np.ndarray  # after the cones
+    coned: np.ndarray
+
+
 def _pipeline(
     raw,
     k,
@@ -375,7 +398,7 @@ def _pipeline(
     budget,
     exact_seconds,
     quiet,
-):
+) -> _Run:
     """Algorithm 1 on validated points, step by step (see :func:`reconstruct`)."""
     with run.step("prepare", timings):
         uniq, first, inverse = np.unique(raw, axis=0, return_index=True, return_inverse=True)
@@ -424,24 +447,10 @@ def _pipeline(
             tri, coned = attach_cones(pts, tri)
         else:
             coned = np.empty(0, dtype=np.int64)
-    return (
-        pts,
-        uniq,
-        first,
-        inverse,
-        dup,
-        k,
-        rng,
-        cycles,
-        sel,
-        faces,
-        tr,
-        centres,
-        n_loops,
-        figs,
-        tri,
-        coned,
-    )
+    return _Run(
+        pts, uniq, first, inverse, dup, k, rng, cycles, sel, faces, tr, centres, n_loops, figs,
+        tri, coned,
+    )  # fmt: skip
 
 
 def reconstruct(
@@ -506,24 +515,7 @@ def reconstruct(
     names = ["prepare", "localized_rng", "isometric_cycles", "backtracking", "triangulate"]
     names += ["self_checks"] * check + ["cones"]
     with Steps(names, quiet) as run, compile_notice(_compiling(quiet)):
-        (
-            pts,
-            uniq,
-            first,
-            inverse,
-            dup,
-            k,
-            rng,
-            cycles,
-            sel,
-            faces,
-            tr,
-            centres,
-            n_loops,
-            figs,
-            tri,
-            coned,
-        ) = _pipeline(
+        r = _pipeline(
             raw,
             k,
             run,
@@ -536,11 +528,18 @@ def reconstruct(
             exact_seconds,
             quiet,
         )
+    return _result(r, timings)
+
+
+def _result(r: _Run, timings: dict[str, float]) -> Reconstruction:
+    """The :class:`Reconstruction` of a run: labels back in the input's order,
+    the success condition read off the final faces."""
+    pts, sel, figs, tr = r.pts, r.selection, r.figures, r.triangulation
     # canonical -> output labels (order of first occurrence in the input)
-    out_order = np.argsort(first, kind="stable")
+    out_order = np.argsort(r.first, kind="stable")
     relabel = np.empty_like(out_order)
     relabel[out_order] = np.arange(out_order.shape[0])
-    rng_edges = np.sort(relabel[rng.edges], axis=1)
+    rng_edges = np.sort(relabel[r.rng.edges], axis=1)
     rng_edges = rng_edges[np.lexsort((rng_edges[:, 1], rng_edges[:, 0]))]
     # the success condition and its figures on the final faces (loops included)
     still_open, disk = figs.open_edges, figs.disk
@@ -548,30 +547,30 @@ def reconstruct(
     now_open = edge_keys(still_open[:, 0], still_open[:, 1], pts.shape[0])
     bad_open = was_open[~sel.true_boundary]
     success = bool(
-        len(faces) > 0
+        len(r.faces) > 0
         and figs.overloaded == 0
         and not np.any(figs.used & ~disk)
         and not np.isin(now_open, bad_open).any()
     )
     open_edges = np.sort(relabel[still_open], axis=1) if still_open.size else still_open
-    faces = CycleSet(offsets=faces.offsets, vertices=relabel[faces.vertices])
+    faces = CycleSet(offsets=r.faces.offsets, vertices=relabel[r.faces.vertices])
     return Reconstruction(
-        vertices=uniq[out_order],
-        triangles=relabel[tri],
-        input_to_vertex=relabel[inverse],
-        duplicates_merged=int(dup),
+        vertices=r.uniq[out_order],
+        triangles=relabel[r.triangles],
+        input_to_vertex=relabel[r.inverse],
+        duplicates_merged=int(r.duplicates),
         rng_edges=rng_edges,
-        candidate_cycles=len(cycles),
+        candidate_cycles=len(r.cycles),
         face_cycles=faces,
         success=bool(success and tr.orientable),
         orientable=bool(tr.orientable),
         open_edges=open_edges,
         unresolved_samples=np.sort(relabel[np.flatnonzero(~disk)]),
         non_disk_neighbourhoods=np.sort(relabel[sel.non_disk_neighbourhoods]),
-        coned_samples=np.sort(relabel[np.r_[coned, list(centres.values())].astype(np.int64)]),
+        coned_samples=np.sort(relabel[np.r_[r.coned, list(r.centres.values())].astype(np.int64)]),
         fallback_components=sel.fallback_components,
-        hole_faces=n_loops,
+        hole_faces=r.loops,
         exact=sel.exact,
         timings=timings,
-        k=k,
+        k=r.k,
     )

@@ -11,7 +11,9 @@ def test_nan_is_named_with_its_row():
     pts = cube_lattice(2)
     pts[5, 1] = np.nan
     with pytest.raises(
-        InputError, match=r"non-finite \(NaN or inf\) coordinates rows, first at row 5"
+        InputError,
+        match=r"^points: 1 of 26 points have non-finite \(NaN or inf\) coordinates, "
+        r"first point 5 = \[",
     ):
         reconstruct(pts, 8)
 
@@ -19,7 +21,7 @@ def test_nan_is_named_with_its_row():
 def test_inf_is_named():
     pts = cube_lattice(2)
     pts[0, 0] = np.inf
-    with pytest.raises(InputError, match="contain 1 non-finite"):
+    with pytest.raises(InputError, match="1 of 26 points have non-finite"):
         reconstruct(pts, 8)
 
 
