@@ -98,10 +98,24 @@ def rigid_motions(draw) -> tuple[np.ndarray, np.ndarray, float]:
 
 @st.composite
 def arbitrary_points(draw) -> np.ndarray:
-    """Robustness inputs: duplicates, collinear, coplanar, clustered, huge, tiny."""
+    """Robustness inputs: duplicates and near duplicates, collinear, coplanar,
+    clustered, huge, tiny, a NaN or an inf mixed in, a sphere (a surface to
+    find) among them."""
     kind = draw(
         st.sampled_from(
-            ["random", "duplicates", "collinear", "coplanar", "cluster", "huge", "tiny", "few"]
+            [
+                "random",
+                "duplicates",
+                "near duplicates",
+                "collinear",
+                "coplanar",
+                "cluster",
+                "huge",
+                "tiny",
+                "few",
+                "sphere",
+                "non-finite",
+            ]
         )
     )
     seed = draw(st.integers(0, 2**31))
@@ -122,4 +136,12 @@ def arbitrary_points(draw) -> np.ndarray:
         p = p * 1e-12
     elif kind == "few":
         p = p[: draw(st.integers(1, 4))]
+    elif kind == "near duplicates":
+        p = np.vstack([p, p[: n // 2] + rng.normal(0, 1e-12, (n // 2, 3))])
+    elif kind == "sphere":
+        p = rng.normal(size=(max(n, 20), 3))
+        p /= np.linalg.norm(p, axis=1)[:, None]
+        p *= 10.0 ** draw(st.sampled_from([-150, -6, 0, 6, 150]))
+    elif kind == "non-finite":
+        p[rng.integers(0, n)] = draw(st.sampled_from([np.nan, np.inf, -np.inf]))
     return p
