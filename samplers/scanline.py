@@ -52,6 +52,10 @@ a CadQuery shape:
   plain scan rows);
 * optional Gaussian jitter (σ·h) and dropout, both seeded.
 
+A model turned off the world axes is scanned in its own frame (the
+directions of its faces, :mod:`sr33.samplers.frame`) and the samples are
+turned back, so that a part's sampling does not depend on how it was placed.
+
 Every sample before jitter lies on the CAD surface (points are evaluated on
 the exact B-rep curves).  The same arguments give identical arrays.
 CadQuery is imported only when this module's functions run.
@@ -80,6 +84,7 @@ from .faces import (
     row_cosine,
     thin,
 )
+from .frame import in_frame, model_frame
 
 AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 EDGE_STEP = 1.0  # spacing of corner/edge samples, times h
@@ -110,7 +115,8 @@ class ScanSamples:
     on_feature : (n,) bool
         True for corner and sharp-edge samples.
     meta : dict
-        spacing h, ratio r, directions, seed, jitter, dropout, shape name,
+        spacing h, ratio r, directions, the frame scanned in (rows: its
+        axes in world coordinates), seed, jitter, dropout, shape name,
         parameters and expected topology (when known), counts.
     """
 
@@ -677,7 +683,10 @@ def scan(
     ratio : float
         Sample spacing along a line, as a multiple r of h (0.6 to 1.7).
     directions : (d, 3) array_like, optional
-        Candidate sweep directions (default: the x, y and z axes).
+        Candidate sweep directions.  By default the x, y and z axes of the
+        model's frame (:func:`sr33.samplers.frame.model_frame`): the world's
+        for a model built upright, the model's own for one turned off them,
+        which is scanned in that frame and turned back (``meta["frame"]``).
     jitter : float
         Standard deviation of isotropic Gaussian noise, as a multiple of h.
     dropout : float
@@ -705,16 +714,49 @@ def scan(
     faces = occ.Faces()
     if not faces:
         raise SamplingError("shape has no faces to sample")
+    area = float(sum(f.Area() for f in faces))
+    if spacing is not None:
+        h = float(spacing)
+    elif target_points is not None:
+        h = math.sqrt(area / (ratio * target_points))
+    else:
+        h = float(getattr(shape, "default_spacing", 0.0) or math.sqrt(area / (ratio * 6000)))
+    frame = model_frame(occ) if directions is None else None
+    if frame is not None and not frame.world:
+        # a model off the world axes is scanned in its own frame and turned back
+        with timed("sample: turned into the model's frame"):
+            local = in_frame(occ, frame.axes)
+        res = scan(
+            local,
+            h,
+            ratio=ratio,
+            directions=AXES,
+            jitter=jitter,
+            dropout=dropout,
+            seed=seed,
+            sharp_degrees=sharp_degrees,
+            repair=repair,
+            quiet=quiet,
+        )
+        expected = getattr(shape, "expected", None)
+        meta = dict(
+            res.meta,
+            shape=getattr(shape, "name", type(occ).__name__),
+            params=dict(getattr(shape, "params", {}) or {}),
+            expected=None if expected is None else vars(expected).copy(),
+            frame=frame.axes.tolist(),
+            directions=(np.asarray(AXES) @ frame.axes).tolist(),
+        )
+        return ScanSamples(
+            points=res.points @ frame.axes,
+            line_id=res.line_id,
+            face_id=res.face_id,
+            on_feature=res.on_feature,
+            meta=meta,
+        )
     with bar(len(faces) + 2 + (8 if repair else 0), "sample", quiet, unit="step") as pbar:
         lo, hi = exact_bounds(occ)
         size = float(norm(hi - lo))
-        area = float(sum(f.Area() for f in faces))
-        if spacing is not None:
-            h = float(spacing)
-        elif target_points is not None:
-            h = math.sqrt(area / (ratio * target_points))
-        else:
-            h = float(getattr(shape, "default_spacing", 0.0) or math.sqrt(area / (ratio * 6000)))
         if area / (h * h * ratio) > 2_000_000:
             raise SamplingError(
                 f"spacing {h:g} would give about {area / (h * h * ratio):.0f} samples; "
@@ -853,6 +895,7 @@ def scan(
             "spacing": h,
             "ratio": float(ratio),
             "directions": dirs.tolist(),
+            "frame": np.eye(3).tolist(),
             "face_directions": [int(f) for f in fam],
             "jitter": float(jitter),
             "dropout": float(dropout),

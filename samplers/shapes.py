@@ -647,14 +647,20 @@ def describe(name: str) -> str:
 PARAM_RANGE = (1e-4, 1e6)  # magnitudes OpenCascade's 1e-7 precision models faithfully
 
 
+#: every shape also takes these: degrees about the world's x, y and z axes
+#: (through the origin), applied in that order after the shape is built;
+#: they appear in ``Shape.params`` only when not 0
+ROTATIONS = ("rotate_x", "rotate_y", "rotate_z")
+
+
 def _resolve(name: str, params: dict[str, Any]) -> dict[str, float]:
     spec = _spec(name)
-    unknown = sorted(set(params) - set(spec.defaults))
+    unknown = sorted(set(params) - set(spec.defaults) - set(ROTATIONS))
     if unknown:
         raise ShapeError(
             f"unknown parameter{'s' if len(unknown) > 1 else ''} "
             f"{', '.join(repr(u) for u in unknown)} for shape {name!r}; "
-            f"allowed: {', '.join(spec.defaults)}"
+            f"allowed: {', '.join((*spec.defaults, *ROTATIONS))}"
         )
     out = dict(spec.defaults)
     for key, value in params.items():
@@ -662,6 +668,12 @@ def _resolve(name: str, params: dict[str, Any]) -> dict[str, float]:
             raise ShapeError(f"{key} must be a number, got {value!r}")
         if not math.isfinite(float(value)):
             raise ShapeError(f"{key} must be finite, got {value!r}")
+        if key in ROTATIONS:
+            if not -360.0 <= float(value) <= 360.0:
+                raise ShapeError(f"{key} must be within [-360, 360] degrees, got {value!r}")
+            if value != 0:
+                out[key] = float(value)
+            continue
         if not (value == 0 or PARAM_RANGE[0] <= abs(float(value)) <= PARAM_RANGE[1]):
             raise ShapeError(
                 f"{key} must be 0 or of magnitude {_fmt(PARAM_RANGE[0])} to "
@@ -912,7 +924,9 @@ def build(name: str, **params: float) -> Shape:
     name : str
         One of :func:`shape_names`.
     **params : float
-        Parameters overriding the defaults of :func:`shape_parameters`.
+        Parameters overriding the defaults of :func:`shape_parameters`, and
+        ``rotate_x``, ``rotate_y``, ``rotate_z`` (degrees, default 0; see
+        :data:`ROTATIONS`): the shape turned against the scan directions.
 
     Returns
     -------
@@ -927,7 +941,10 @@ def build(name: str, **params: float) -> Shape:
     """
     p = _resolve(name, params)
     try:
-        solid = _SPECS[name].make(p)
+        solid = _SPECS[name].make({k: v for k, v in p.items() if k not in ROTATIONS})
+        for axis, key in zip(((1, 0, 0), (0, 1, 0), (0, 0, 1)), ROTATIONS):
+            if key in p:
+                solid = solid.rotate((0, 0, 0), axis, p[key])
     except ImportError:
         raise  # CadQuery missing: the caller says which extra to install
     except Exception as exc:  # OCP raises Standard_Failure and its kin

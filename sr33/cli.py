@@ -168,6 +168,10 @@ def _cmd_sample(args) -> int:
             defaults = ", ".join(f"{k}={v:g}" for k, v in shapes.shape_parameters(name).items())
             print(f"{name:<16} {shapes.describe(name)}")
             print(f"{'':<16} parameters: {defaults}")
+        print(
+            f"every shape also takes {', '.join(shapes.ROTATIONS)}: degrees about the "
+            "x, y and z axes, in that order (default 0)"
+        )
         return 0
     if not args.shape:
         raise InputError(

@@ -18,6 +18,23 @@ def test_list_names_every_shape_with_parameters(capsys):
     for name in ("cube", "cutcube", "L_sheet", "wedge", "square_ring", "block_two_holes"):
         assert name in out
     assert "parameters:" in out
+    assert "every shape also takes rotate_x, rotate_y, rotate_z: degrees" in out
+
+
+def test_sample_a_turned_shape_records_its_frame(tmp_path):
+    """--param rotate_z=30: the meta records the parameter and the frame
+    the shape was scanned in (its own, turned 30 degrees about z)."""
+    meta = tmp_path / "m.json"
+    argv = ["sample", "cube", "--param", "rotate_z=30", "--no-repair", "--points", "600"]
+    assert main(argv + ["-o", str(tmp_path / "p.npy"), "--meta", str(meta), "-q"]) == 0
+    doc = json.loads(meta.read_text())
+    assert doc["params"] == {"side": 1.0, "rotate_z": 30.0}
+    frame = np.array(doc["frame"])
+    c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
+    turn = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    # the frame's axes are the turned cube's, up to the cube's quarter turns
+    np.testing.assert_allclose(np.abs(frame @ turn).round(9) % 1, 0, atol=1e-9)
+    assert not np.allclose(frame, np.eye(3))
 
 
 def test_sample_writes_points_truth_and_meta(tmp_path, capsys):

@@ -229,11 +229,16 @@ BAD = [
         "apex_height must be greater than 1.1 times the radius (0.385), got 0.3",
     ),
     ("square_ring", {"section": 0.8}, "section must be less than twice the radius (0.8), got 0.8"),
-    ("cube", {"sidee": 1}, "unknown parameter 'sidee' for shape 'cube'; allowed: side"),
+    (
+        "cube",
+        {"sidee": 1},
+        "unknown parameter 'sidee' for shape 'cube'; allowed: side, rotate_x, rotate_y, rotate_z",
+    ),
     (
         "cylinder",
         {"r": 1, "h": 2},
-        "unknown parameters 'h', 'r' for shape 'cylinder'; allowed: radius, height",
+        "unknown parameters 'h', 'r' for shape 'cylinder'; allowed: radius, height, "
+        "rotate_x, rotate_y, rotate_z",
     ),
     ("cube", {"side": "1"}, "side must be a number, got '1'"),
     ("cube", {"side": True}, "side must be a number, got True"),
