@@ -141,6 +141,16 @@ def _occ(shape):
     return solid
 
 
+def _shape_meta(shape, occ) -> dict[str, Any]:
+    """What a sampling's meta says of its shape: name, parameters, expected topology."""
+    expected = getattr(shape, "expected", None)
+    return {
+        "shape": getattr(shape, "name", type(occ).__name__),
+        "params": dict(getattr(shape, "params", {}) or {}),
+        "expected": None if expected is None else vars(expected).copy(),
+    }
+
+
 def _check_args(spacing, target_points, ratio, jitter, dropout, seed, directions):
     if spacing is not None and target_points is not None:
         raise SamplingError("give either spacing or target_points, not both")
@@ -738,12 +748,9 @@ def scan(
             repair=repair,
             quiet=quiet,
         )
-        expected = getattr(shape, "expected", None)
         meta = dict(
             res.meta,
-            shape=getattr(shape, "name", type(occ).__name__),
-            params=dict(getattr(shape, "params", {}) or {}),
-            expected=None if expected is None else vars(expected).copy(),
+            **_shape_meta(shape, occ),
             frame=frame.axes.tolist(),
             directions=(np.asarray(AXES) @ frame.axes).tolist(),
         )
@@ -887,11 +894,8 @@ def scan(
                 face_id[mask],
                 on_feature[mask],
             )
-        expected = getattr(shape, "expected", None)
         meta = {
-            "shape": getattr(shape, "name", type(occ).__name__),
-            "params": dict(getattr(shape, "params", {}) or {}),
-            "expected": None if expected is None else vars(expected).copy(),
+            **_shape_meta(shape, occ),
             "spacing": h,
             "ratio": float(ratio),
             "directions": dirs.tolist(),
