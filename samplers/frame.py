@@ -19,9 +19,10 @@ ones, and builds a frame from them:
   the most area (ties: the one the model is longest along, as a part lies
   on a table, then the first in face order), or for a model with no
   direction perpendicular to z (a cylinder, a cone) the x axis of z's
-  first surface; each direction's sign is that of the first face having
-  it, so the frame turns with the model (rotating a B-rep keeps its faces'
-  order and parametrisation);
+  first surface; each direction points away from its largest planar face
+  (the one the model would rest on), or along its first face's axis, so
+  the frame turns with the model (rotating a B-rep keeps its faces' order,
+  orientation and parametrisation);
 * the world axes are kept unless the model's frame lines up at least
   ``SWITCH`` (a quarter) of the surface area more than they do.  Every
   library shape built upright keeps them (the largest gain among the 14 is
@@ -90,12 +91,14 @@ def surface_directions(solid) -> tuple[np.ndarray, np.ndarray]:
     Returns
     -------
     directions : (m, 3) float64
-        Unit vectors, in face order.
+        Unit vectors, in face order (a planar face's outward normal).
     areas : (m,) float64
     references : (m, 3) float64
         Each surface's own x direction (the first axis of its local
         coordinate system, perpendicular to the direction): it turns with
         the model and decides a frame's x where the model has one direction.
+    planar : (m,) bool
+        Which faces are planar.
     """
     from OCP.BRepAdaptor import BRepAdaptor_Surface
     from OCP.GeomAbs import (
@@ -107,7 +110,7 @@ def surface_directions(solid) -> tuple[np.ndarray, np.ndarray]:
         GeomAbs_Torus,
     )
 
-    dirs, areas, refs = [], [], []
+    dirs, areas, refs, planar = [], [], [], []
     for face in solid.Faces():
         s = BRepAdaptor_Surface(face.wrapped)
         kind = s.GetType()
@@ -128,17 +131,23 @@ def surface_directions(solid) -> tuple[np.ndarray, np.ndarray]:
             dirs.append((d.X(), d.Y(), d.Z()))
             areas.append(float(face.Area()))
             refs.append(np.full(3, np.nan))  # no frame of its own
+            planar.append(False)
             continue
         else:
             continue
         d, x = ax3.Direction(), ax3.XDirection()
-        dirs.append((d.X(), d.Y(), d.Z()))
+        if kind == GeomAbs_Plane:  # the outward normal: the face's orientation counts
+            dirs.append(face.normalAt().toTuple())
+        else:
+            dirs.append((d.X(), d.Y(), d.Z()))
         refs.append((x.X(), x.Y(), x.Z()))
         areas.append(float(face.Area()))
+        planar.append(kind == GeomAbs_Plane)
     return (
         np.array(dirs, dtype=np.float64).reshape(-1, 3),
         np.array(areas, dtype=np.float64),
         np.array(refs, dtype=np.float64).reshape(-1, 3),
+        np.array(planar, dtype=bool),
     )
 
 
@@ -146,11 +155,15 @@ def _parallel(a: np.ndarray, b: np.ndarray) -> bool:
     return float(norm(np.cross(a, b))) < TOL
 
 
-def _groups(dirs: np.ndarray, areas: np.ndarray, refs: np.ndarray) -> list[tuple]:
-    """Parallel directions as one (the first one's vector and reference x),
-    with their total area."""
+def _groups(dirs, areas, refs, planar) -> list[tuple]:
+    """Parallel directions as one, with their total area and reference x.
+
+    A group points away from its largest planar face (the face the model
+    would rest on: a filleted box's bottom, not its smaller top; ties: the
+    first in face order), or along its first face's direction if it has no
+    planar face."""
     out: list[list] = []
-    for d, w, r in zip(dirs, areas, refs):
+    for d, w, r, flat in zip(dirs, areas, refs, planar):
         for g in out:
             if _parallel(g[0], d):
                 g[1] += float(w)
@@ -158,8 +171,11 @@ def _groups(dirs: np.ndarray, areas: np.ndarray, refs: np.ndarray) -> list[tuple
                     g[2] = r
                 break
         else:
-            out.append([d, float(w), r])
-    return [(g[0], g[1], g[2]) for g in out]
+            g = [d, float(w), r, None, 0.0]
+            out.append(g)
+        if flat and w > g[4] * (1 + _WEIGHT_TIE):
+            g[3], g[4] = -d, float(w)
+    return [(g[0] if g[3] is None else g[3], g[1], g[2]) for g in out]
 
 
 def _aligned(axes: np.ndarray, groups) -> float:
@@ -210,11 +226,11 @@ def model_frame(solid) -> Frame:
     >>> f.world, round(f.aligned, 6), round(f.world_aligned, 6)
     (False, 1.0, 0.0)
     """
-    dirs, areas, refs = surface_directions(solid)
+    dirs, areas, refs, planar = surface_directions(solid)
     total = float(sum(f.Area() for f in solid.Faces()))
     if areas.shape[0] == 0 or total <= 0:
         return Frame(WORLD.copy(), True, 0.0, 0.0)
-    groups = _groups(dirs, areas, refs)
+    groups = _groups(dirs, areas, refs, planar)
     world = _aligned(WORLD, groups)
     best, best_w, best_x = None, -1.0, 0.0
     for axes in _frames(groups):
