@@ -19,9 +19,10 @@ ones, and builds a frame from them:
   the most area (ties: the one the model is longest along, as a part lies
   on a table, then the first in face order), or for a model with no
   direction perpendicular to z (a cylinder, a cone) the x axis of z's
-  first surface; each direction points away from its largest planar face
-  (the one the model would rest on), or along its first face's axis, so
-  the frame turns with the model (rotating a B-rep keeps its faces' order,
+  first surface; each direction points along the axis of its first axial
+  face (a cylinder's, a cone's: as the model was built), else away from
+  its largest planar face (the one the model would rest on), so the frame
+  turns with the model (rotating a B-rep keeps its faces' order,
   orientation and parametrisation);
 * the world axes are kept unless the model's frame lines up at least
   ``SWITCH`` (a quarter) of the surface area more than they do.  Every
@@ -158,10 +159,10 @@ def _parallel(a: np.ndarray, b: np.ndarray) -> bool:
 def _groups(dirs, areas, refs, planar) -> list[tuple]:
     """Parallel directions as one, with their total area and reference x.
 
-    A group points away from its largest planar face (the face the model
-    would rest on: a filleted box's bottom, not its smaller top; ties: the
-    first in face order), or along its first face's direction if it has no
-    planar face."""
+    A group points along its first axial face's axis (block_two_holes' holes
+    point up as built), else away from its largest planar face (the face
+    the model would rest on: a filleted box's bottom, not its smaller top;
+    ties: the first in face order)."""
     out: list[list] = []
     for d, w, r, flat in zip(dirs, areas, refs, planar):
         for g in out:
@@ -171,11 +172,13 @@ def _groups(dirs, areas, refs, planar) -> list[tuple]:
                     g[2] = r
                 break
         else:
-            g = [d, float(w), r, None, 0.0]
+            g = [d, float(w), r, None, 0.0, None]
             out.append(g)
         if flat and w > g[4] * (1 + _WEIGHT_TIE):
             g[3], g[4] = -d, float(w)
-    return [(g[0] if g[3] is None else g[3], g[1], g[2]) for g in out]
+        if not flat and g[5] is None:
+            g[5] = d
+    return [(g[5] if g[5] is not None else g[3], g[1], g[2]) for g in out]
 
 
 def _aligned(axes: np.ndarray, groups) -> float:

@@ -1,9 +1,16 @@
-"""Hypothesis strategies: small clouds, lattice clouds with exact ties, rotations."""
+"""Hypothesis strategies: small clouds, lattice clouds with exact ties,
+rotations, library shapes' parameters, robustness inputs, generated CAD models."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
+from hypothesis import assume
 from hypothesis import strategies as st
+
+from tests import fuzzstats
 
 
 @st.composite
@@ -145,3 +152,251 @@ def arbitrary_points(draw) -> np.ndarray:
     elif kind == "non-finite":
         p[rng.integers(0, n)] = draw(st.sampled_from([np.nan, np.inf, -np.inf]))
     return p
+
+
+# --- generated CAD models (issue 24 item 1) -----------------------------------------
+
+#: the feature classes a generated model is reported under (``make fuzz``)
+FEATURE_CLASSES = (
+    "acute edge",
+    "cone apex",
+    "smooth blend",
+    "chamfer",
+    "hole",
+    "boolean seam",
+    "curved face",
+    "reflex edge",
+)
+PRIMITIVES = ("box", "cylinder", "cone", "frustum", "sphere", "torus", "prism", "star prism")
+
+
+@dataclass(frozen=True)
+class CadModel:
+    """A generated solid with its library record and what it exercises.
+
+    ``recipe`` says how it was built (a shrunk failure names its model),
+    ``shape`` is :func:`sr33.samplers.shapes.from_cad`'s record (B-rep
+    topology, truth mesh), ``features`` the classes it has, read from the
+    result (the B-rep and its truth mesh), not assumed from the recipe.
+    """
+
+    recipe: str
+    shape: Any
+    features: frozenset
+
+
+def _polygon(draw, convex: bool) -> list[tuple[float, float]]:
+    """A polygon about the origin: convex (points on a circle at jittered
+    angles) or star-shaped non-convex (alternating radii)."""
+    if convex:
+        n = draw(st.integers(3, 8))
+        step = 2 * np.pi / n
+        angles = [k * step + draw(st.floats(-0.3, 0.3)) * step for k in range(n)]
+        r = draw(st.floats(0.4, 0.7))
+        return [(r * np.cos(a), r * np.sin(a)) for a in angles]
+    n = draw(st.integers(3, 6))
+    outer, inner = draw(st.floats(0.5, 0.7)), draw(st.floats(0.3, 0.8))
+    pts = []
+    for k in range(2 * n):
+        a = np.pi * k / n
+        r = outer if k % 2 == 0 else outer * inner
+        pts.append((r * np.cos(a), r * np.sin(a)))
+    return pts
+
+
+def _primitive(draw, kind: str):
+    import cadquery as cq
+
+    size = lambda lo=0.4, hi=1.2: draw(st.floats(lo, hi))  # noqa: E731
+    if kind == "box":
+        a, b, c = size(), size(), size()
+        return cq.Solid.makeBox(
+            a, b, c, pnt=cq.Vector(-a / 2, -b / 2, -c / 2)
+        ), f"box {a:.3g} {b:.3g} {c:.3g}"
+    if kind == "cylinder":
+        r, h = size(0.2, 0.6), size()
+        return cq.Solid.makeCylinder(
+            r, h, pnt=cq.Vector(0, 0, -h / 2)
+        ), f"cylinder r {r:.3g} h {h:.3g}"
+    if kind in ("cone", "frustum"):
+        r, h = size(0.2, 0.6), size()
+        top = 0.0 if kind == "cone" else r * draw(st.floats(0.2, 0.8))
+        return cq.Solid.makeCone(
+            r, top, h, pnt=cq.Vector(0, 0, -h / 2)
+        ), f"{kind} r {r:.3g} top {top:.3g} h {h:.3g}"
+    if kind == "sphere":
+        r = size(0.3, 0.6)
+        return cq.Solid.makeSphere(r, angleDegrees1=-90, angleDegrees2=90), f"sphere r {r:.3g}"
+    if kind == "torus":
+        big = size(0.35, 0.6)
+        small = big * draw(st.floats(0.2, 0.5))
+        return cq.Solid.makeTorus(big, small), f"torus {big:.3g} {small:.3g}"
+    pts = _polygon(draw, convex=kind == "prism")
+    h = size(0.2, 0.8)
+    solid = cq.Workplane().polyline(pts).close().extrude(h).translate((0, 0, -h / 2)).val()
+    return solid, f"{kind} over {len(pts)} corners h {h:.3g}"
+
+
+def _dihedral_features(vertices: np.ndarray, triangles: np.ndarray) -> set[str]:
+    """'acute edge' where the truth mesh turns by more than 100 degrees across
+    an edge (an interior angle below 80), 'reflex edge' where it turns
+    inwards by more than 20 (a concave sharp edge)."""
+    p = vertices[triangles]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+    pairs: dict[tuple[int, int], list[int]] = {}
+    for t, tri in enumerate(triangles.tolist()):
+        for i in range(3):
+            a, b = tri[i], tri[(i + 1) % 3]
+            pairs.setdefault((min(a, b), max(a, b)), []).append(t)
+    out = set()
+    for (a, b), ts in pairs.items():
+        if len(ts) != 2:
+            continue
+        s, t = ts
+        cos = float(n[s] @ n[t])
+        if cos < np.cos(np.radians(100)):
+            out.add("acute edge")
+        # concave: the other triangle's far corner lies outside s's plane
+        far = [v for v in triangles[t] if v not in (a, b)][0]
+        if cos < np.cos(np.radians(20)) and float(n[s] @ (vertices[far] - vertices[a])) > 0:
+            out.add("reflex edge")
+    return out
+
+
+def _cone_apex(solid) -> bool:
+    """A conical face ending in a point: its surface's apex is a vertex of the model."""
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+
+    corners = np.array([v.toTuple() for v in solid.Vertices()]).reshape(-1, 3)
+    for f in solid.Faces():
+        if f.geomType() != "CONE":
+            continue
+        a = BRepAdaptor_Surface(f.wrapped).Cone().Apex()
+        gap = np.linalg.norm(corners - [a.X(), a.Y(), a.Z()], axis=1)
+        if gap.size and gap.min() < 1e-7:
+            return True
+    return False
+
+
+def _reject(reason: str) -> None:
+    fuzzstats.reject(reason)
+    assume(False)
+
+
+#: primitives and operations that give each feature class (the ci profile
+#: draws every class through these)
+FOR_FEATURE = {
+    "acute edge": (("cone", "frustum", "star prism"), ()),
+    "cone apex": (("cone",), ()),
+    "smooth blend": (("box", "prism", "star prism"), ("fillet",)),
+    "chamfer": (("box", "prism", "cylinder"), ("chamfer",)),
+    "hole": (("box", "prism", "cylinder", "torus"), ("hole",)),
+    "boolean seam": (("box", "cylinder", "sphere", "prism"), ("union", "cut")),
+    "curved face": (("cylinder", "sphere", "torus", "frustum"), ()),
+    "reflex edge": (("star prism",), ()),
+}
+
+
+@st.composite
+def cad_models(draw, feature: str | None = None) -> CadModel:
+    """A solid composed from primitives (box, cylinder, cone, frustum,
+    sphere, torus, prisms over convex and star-shaped polygons), then up to
+    two of: a union with a second primitive, a cut of one, a through hole,
+    fillets of the vertical edges, chamfers of the top edges (random sizes),
+    then a random rigid motion.  Models CadQuery cannot build, that are not
+    one valid solid, or whose truth mesh does not fit the B-rep are
+    rejected (``assume``), each with its reason counted
+    (:data:`fuzzstats.REJECTED`).  ``feature`` draws from the primitives and
+    operations that give that class (:data:`FOR_FEATURE`)."""
+    import cadquery as cq
+
+    from sr33.samplers import shapes
+
+    kinds, forced = FOR_FEATURE[feature] if feature else (PRIMITIVES, ())
+    kind = draw(st.sampled_from(kinds))
+    solid, recipe = _primitive(draw, kind)
+    steps = [recipe]
+    done: set[str] = set()
+    ops = draw(
+        st.lists(
+            st.sampled_from(["union", "cut", "hole", "fillet", "chamfer"]), max_size=2, unique=True
+        )
+    )
+    if forced:
+        ops = [draw(st.sampled_from(forced))] + [op for op in ops if op not in forced][:1]
+    for op in ops:
+        bb = solid.BoundingBox()
+        lo, hi = np.array([bb.xmin, bb.ymin, bb.zmin]), np.array([bb.xmax, bb.ymax, bb.zmax])
+        ext = hi - lo
+        try:
+            if op in ("union", "cut"):
+                other, what = _primitive(draw, draw(st.sampled_from(["box", "cylinder", "sphere"])))
+                # centred on a point of the bounding box's top, so that it overlaps
+                at = lo + ext * np.array(
+                    [draw(st.floats(0.3, 0.7)), draw(st.floats(0.3, 0.7)), 1.0]
+                )
+                other = other.scale(0.6).translate(cq.Vector(*at))
+                new = solid.fuse(other) if op == "union" else solid.cut(other)
+                steps.append(f"{op} {what} x0.6 at {np.round(at, 3).tolist()}")
+            elif op == "hole":
+                r = 0.15 * float(min(ext[0], ext[1]))
+                tool = cq.Solid.makeCylinder(
+                    r, 3 * ext[2] + 1, pnt=cq.Vector(*(lo + ext / 2 - [0, 0, 1.5 * ext[2] + 0.5]))
+                )
+                new = solid.cut(tool)
+                steps.append(f"hole r {r:.3g}")
+            elif op == "fillet":
+                edges = [
+                    e
+                    for e in solid.Edges()
+                    if e.geomType() == "LINE" and abs(e.tangentAt(0.5).z) > 0.999
+                ]
+                if not edges:
+                    continue
+                r = draw(st.floats(0.05, 0.2)) * min(e.Length() for e in edges)
+                new = solid.fillet(r, edges)
+                steps.append(f"fillet {len(edges)} vertical edges r {r:.3g}")
+            else:
+                top = float(hi[2])
+                edges = [
+                    e
+                    for e in solid.Edges()
+                    if abs(e.Center().z - top) < 1e-6 and abs(e.tangentAt(0.5).z) < 1e-6
+                ]
+                if not edges:
+                    continue
+                d = draw(st.floats(0.03, 0.12)) * float(min(ext))
+                new = solid.chamfer(d, None, edges)
+                steps.append(f"chamfer {len(edges)} top edges {d:.3g}")
+        except Exception as exc:  # OpenCascade refuses: Standard_Failure and kin
+            _reject(f"{op} failed ({type(exc).__name__})")
+        if len(new.Solids()) != 1:
+            _reject(f"{op} gave {len(new.Solids())} solids")
+        solid = cq.Solid(new.Solids()[0].wrapped)
+        done.add(op)
+    angles = [draw(st.floats(-180, 180)) for _ in range(3)]
+    move = [draw(st.floats(-5, 5)) for _ in range(3)]
+    for axis, a in zip(((1, 0, 0), (0, 1, 0), (0, 0, 1)), angles):
+        solid = solid.rotate((0, 0, 0), axis, a)
+    solid = solid.translate(cq.Vector(*move))
+    steps.append(f"turned {np.round(angles, 2).tolist()} moved {np.round(move, 3).tolist()}")
+    recipe = "; ".join(steps)
+    try:
+        shape = shapes.from_cad(solid, name="generated")
+    except shapes.ShapeError as exc:
+        _reject(str(exc).split(":")[-1].strip()[:60])
+    features = _dihedral_features(shape.truth_vertices, shape.truth_triangles)
+    if _cone_apex(solid):
+        features.add("cone apex")
+    if "fillet" in done:
+        features.add("smooth blend")
+    if "chamfer" in done:
+        features.add("chamfer")
+    if shape.expected.genus > 0:
+        features.add("hole")
+    if done & {"union", "cut"}:
+        features.add("boolean seam")
+    if any(f.geomType() != "PLANE" for f in solid.Faces()):
+        features.add("curved face")
+    return CadModel(recipe, shape, frozenset(features))
