@@ -37,7 +37,7 @@ from sr33.mesh import dot, norm
 
 from .adjacency import EdgeFaces
 from .chart import halving_count, radial_clamp
-from .faces import goes_round, perpendicular
+from .faces import goes_round, perpendicular, steps
 from .repair import MOVABLE, repair
 from .samples import Samples
 
@@ -162,10 +162,10 @@ def ring_plan(radii: tuple[float, ...], h: float) -> tuple[float, list[tuple[flo
     """
     outer = radii[0]
     inner = radii[1] if len(radii) > 1 else 0.0
-    rows = max(1, round((outer - inner) / h))
+    rows = steps(outer - inner, h)
     t = (outer - inner) / rows
     if inner > 0:
-        base = max(3, round(2 * math.pi * inner / h))
+        base = steps(2 * math.pi * inner, h, least=3)
         top = max(0, math.floor(math.log2(2 * math.pi * outer / (HALVE_GAP * t * base))))
         count = rows + 1
     else:

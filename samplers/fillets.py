@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .faces import exact_bounds, nearest_face, revolution_axis, thin
+from .faces import exact_bounds, nearest_face, revolution_axis, steps, thin
 from .samples import Samples
 from .spheres import repair_sphere_face
 
@@ -133,7 +133,7 @@ def _octant_rows(radius: float, n: int, h: float) -> list[np.ndarray]:
     for k in range(1, n):
         phi = k * math.pi / (2 * n)
         ring = radius * math.sin(phi)
-        m = max(1, round(ring * math.pi / 2 / h))
+        m = steps(ring * math.pi / 2, h)
         t = np.linspace(0.0, math.pi / 2, m + 1)
         rows.append(
             np.stack(
@@ -207,10 +207,10 @@ def lattice_filleted_box(occ, s: Samples, h: float, size: float) -> tuple[list[d
     lo, hi, r = box.lo, box.hi, box.radius
     x0, x1, y0, y1 = lo[0] + r, hi[0] - r, lo[1] + r, hi[1] - r
     zb, zt = lo[2], hi[2] - r
-    n = max(1, round(math.pi * r / (2 * h)))
-    xs = np.linspace(x0, x1, max(1, round((x1 - x0) / h)) + 1)
-    ys = np.linspace(y0, y1, max(1, round((y1 - y0) / h)) + 1)
-    zs = np.linspace(zb, zt, max(1, round((zt - zb) / h)) + 1)[1:]  # the bottom's row is kept
+    n = steps(math.pi * r / 2, h)
+    xs = np.linspace(x0, x1, steps(x1 - x0, h) + 1)
+    ys = np.linspace(y0, y1, steps(y1 - y0, h) + 1)
+    zs = np.linspace(zb, zt, steps(zt - zb, h) + 1)[1:]  # the bottom's row is kept
     ang = np.linspace(0.0, math.pi / 2, n + 1)
     corners = [(sx, sy) for sx in (-1, 1) for sy in (-1, 1)]
     octant = _octant_rows(r, n, h)

@@ -39,7 +39,14 @@ from .chart import (
     radial_clamp,
     segment_distance,
 )
-from .faces import boundary_segments, goes_round, perpendicular, revolution_axis, row_cosine
+from .faces import (
+    boundary_segments,
+    goes_round,
+    perpendicular,
+    revolution_axis,
+    row_cosine,
+    steps,
+)
 from .repair import GAP, MOVABLE, Repaired, copies, repair, split_corners
 from .samples import Samples
 
@@ -611,7 +618,7 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
         a_lo, a_hi = np.sort(ang[rim_lo]), np.sort(ang[rim_hi])
         if a_lo.size < 3 or a_lo.size != a_hi.size or np.abs(a_lo - a_hi).max() > 1e-9:
             continue
-        rows = max(1, round((vmax - vmin) / h))
+        rows = steps(vmax - vmin, h)
         z = vmin + (vmax - vmin) * np.arange(1, rows) / rows
         zz = np.repeat(z, a_lo.size)
         aa = np.tile(a_lo, z.size)
@@ -688,7 +695,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         if rim.size < 3:
             continue  # the rim is a smooth edge (cone_tip): left to the scan rows
         slant = top / math.cos(abs(cone.SemiAngle()))
-        rows = max(1, round(slant / h))
+        rows = steps(slant, h)
         t = slant / rows
         rim_ang = np.sort(np.arctan2(dot(q[rim], ey), dot(q[rim], ex)) % (2 * math.pi))
         ang = rim_ang
@@ -1108,7 +1115,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     seg = [np.r_[0.0, np.cumsum(np.hypot(np.diff(q[2]), np.diff(q[3])))] for q in parts]
     starts = np.cumsum([0.0] + [x[-1] for x in seg[:-1]])
     total = float(starts[-1] + seg[-1][-1])
-    rows = max(2, round(total / h))
+    rows = steps(total, h, least=2)
     t = total / rows
     umin = [f._uvBounds()[0] for f in faces]
 

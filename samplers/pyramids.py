@@ -48,7 +48,7 @@ from scipy.spatial import Delaunay
 from sr33.mesh import dot, norm, triangle_ratios
 
 from .adjacency import EdgeFaces
-from .faces import nearest_face
+from .faces import nearest_face, steps
 from .repair import BAD
 from .samples import Samples
 
@@ -148,7 +148,7 @@ def find_pyramid(occ, tol: float) -> Pyramid | None:
 def pyramid_steps(width: float, tan_beta: float, h: float) -> int:
     """N, the base lattice's steps per side: the even number nearest
     ``width sqrt(tan_beta) / h`` (at least 4)."""
-    return 2 * max(2, round(width * math.sqrt(tan_beta) / (2 * h)))
+    return 2 * steps(width * math.sqrt(tan_beta) / 2, h, least=2)
 
 
 def _worst(uv: np.ndarray) -> tuple[int, float]:

@@ -82,6 +82,7 @@ from .faces import (
     perpendicular,
     rims_sampled,
     row_cosine,
+    steps,
     thin,
 )
 from .frame import in_frame, model_frame
@@ -192,7 +193,7 @@ def _box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
 
 def _dividing_step(extent: float, h: float) -> float:
     """The spacing nearest ``h`` that divides ``extent`` into whole steps."""
-    return extent / max(1, round(extent / h)) if extent > 0 else h
+    return extent / steps(extent, h) if extent > 0 else h
 
 
 def _face_family(face, dirs: np.ndarray, tol: float) -> int:
@@ -370,7 +371,7 @@ def _sample_chain(
         return _sphere_row(chain, step, sphere)
     lengths = np.array([e.Length() for e, _ in chain])
     total = float(lengths.sum())
-    m = max(1, int(round(total / step)))
+    m = steps(total, step)
     if closed and m < 3:
         m = 3
     count = m if closed else m + 1
@@ -598,7 +599,7 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
                 continue  # smooth edge (fillet tangency) or seam: sampled by scan lines
         elif len(uniq) != 1 or uses != 1:
             continue  # a seam edge (one face on both sides): sampled by scan lines
-        m = max(1, int(round(length / step)))
+        m = steps(length, step)
         cross = None
         if edge.geomType() == "LINE":
             a = np.array(edge.startPoint().toTuple())

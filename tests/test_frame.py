@@ -93,12 +93,14 @@ def test_a_turned_cube_samples_as_the_upright_one():
     assert np.nanmax(rep.worst_ratio) < 0.71 and rep.max_degree <= 33
 
 
-@pytest.mark.parametrize("name", ["wedge", "cylinder"])
+@pytest.mark.parametrize("name", ["wedge", "cylinder", "block_two_holes"])
 def test_two_turns_of_a_model_give_one_scan(name):
     """The scan rows do not depend on how the model was placed: wedge
-    (slanted faces, an acute edge) and cylinder (one direction: its x is
-    the seam's side) under two turns give the same samples in their frame,
-    within 1e-9 h, on the same faces.  (The boundary-layer repair that
+    (slanted faces, an acute edge), cylinder (one direction: its x is the
+    seam's side) and block_two_holes (its 0.5 high sides take 12.5 steps of
+    0.04: a half-way count the turn's rounding decided, 12 or 13, before
+    ``samplers.faces.steps``) under two turns give the same samples in their
+    frame, within 1e-9 h, on the same faces.  (The boundary-layer repair that
     follows is a local search: a turn's rounding, 1e-16, moves wedge's
     repaired samples by up to 0.3 h.)"""
     a, b = (scan(_turned(name, t), repair=False) for t in TURNS)
@@ -142,3 +144,17 @@ def test_rotation_parameters():
         shapes.build("cube", rotate_x=400)
     with pytest.raises(shapes.ShapeError, match="allowed: side, rotate_x, rotate_y, rotate_z"):
         shapes.build("cube", turn=3)
+
+
+def test_a_turned_model_in_its_upright_frame_scans_as_the_upright_one():
+    """block_two_holes turned off the axes is scanned in exactly its upright
+    position (its frame's z along its holes' axes, x along its length): the
+    scan rows are the upright shape's, turned, within 1e-9 h."""
+    upright = shapes.build("block_two_holes")
+    turned = _turned("block_two_holes", "a")
+    a = scan(upright, repair=False)
+    b = scan(turned, repair=False)
+    back = b.points @ np.asarray(b.meta["frame"]).T
+    assert back.shape == a.points.shape
+    gap, _ = cKDTree(a.points).query(back)
+    assert gap.max() < 1e-9 * a.meta["spacing"]
