@@ -55,7 +55,7 @@ def test_nonconforming_mesh_terminates_and_reports(name):
     ends, every sample is a vertex, and ``success`` says what the output is:
     the success condition (closed except at true boundaries, every link a
     disk) exactly when the validators measure a closed 2-manifold.  It does
-    not certify the topology (cheburashka closes with two handles the real
+    not certify the topology (cheburashka closes with a handle the real
     model does not have; only a truth tells): the genus is in the report."""
     from sr33.validators.signature import signature
 
