@@ -320,6 +320,19 @@ def _clamp_lines(lines: list[_Line], h: float):
     return clamp
 
 
+#: positions are compared for congruence on a grid of this many spacings
+CONGRUENCE_GRID = 1e-6
+
+
+def _congruence(x, h: float) -> bytes:
+    """Positions (2-D points, a centre, a radius) as a key for "the same
+    layout": rounded to ``CONGRUENCE_GRID`` h (with -0.0 made 0.0), so that
+    two congruent faces are told equal whatever the last bits of their
+    coordinates (a turned model's ends differ by 1e-14 h; rounded to 1e-12
+    absolute they were unequal one time in two and got different repairs)."""
+    return (np.round(np.asarray(x, dtype=np.float64) / h / CONGRUENCE_GRID) + 0.0).tobytes()
+
+
 def repair_planar_faces(
     occ, s: Samples, h: float, size: float, row_dirs=None, skip=frozenset(), again: bool = True
 ) -> list[dict]:
@@ -431,13 +444,14 @@ def repair_planar_faces(
         frame = np.vstack([np.empty((0, 2))] + [ln.frame for ln in lines if not ln.follows])
         # congruent faces (a prism's two ends) get one answer: their rims must agree
         key = (
-            uv.round(12).tobytes(),
+            _congruence(uv, h),
             slide.tobytes(),
             free.tobytes(),
             tuple(
-                (tuple(a.centre.round(12)), round(a.radius, 12), a.closed, a.slides) for a in arcs
+                (_congruence(a.centre, h), _congruence(a.radius, h), a.closed, a.slides)
+                for a in arcs
             ),
-            frame.round(12).tobytes(),
+            _congruence(frame, h),
         )
         # a prism's ends bounded by straight edges: the same edges and edge
         # samples get one answer even where their scan rows differ inside (a
@@ -446,13 +460,13 @@ def repair_planar_faces(
         outline = None
         if not arcs:
             outline = (
-                uv[feat].round(12).tobytes(),
+                _congruence(uv[feat], h),
                 slide[feat].tobytes(),
                 *sorted(
-                    (*sorted([tuple(ln.a.round(12)), tuple(ln.b.round(12))]), ln.slides, ln.follows)
+                    (*sorted([_congruence(ln.a, h), _congruence(ln.b, h)]), ln.slides, ln.follows)
                     for ln in lines
                 ),
-                frame.round(12).tobytes(),
+                _congruence(frame, h),
             )
         if key not in done and outline in outlines:
             done[key] = _answer_for(outlines[outline], uv, tol)

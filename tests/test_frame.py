@@ -158,3 +158,22 @@ def test_a_turned_model_in_its_upright_frame_scans_as_the_upright_one():
     assert back.shape == a.points.shape
     gap, _ = cKDTree(a.points).query(back)
     assert gap.max() < 1e-9 * a.meta["spacing"]
+
+
+def test_congruent_faces_are_told_equal_whatever_their_last_bits():
+    """repair_planar_faces gives congruent faces (a prism's two ends) one
+    answer; their layouts are compared on a grid of 1e-6 h, so that a turned
+    model's ends, 1e-14 h apart, are still equal (rounded to 1e-12 absolute
+    they were unequal about one time in two), and -0.0 is 0.0."""
+    from sr33.samplers.layers import _congruence
+
+    h = 0.04
+    rng = np.random.default_rng(0)
+    uv = rng.random((500, 2)) * 2.0
+    noisy = uv + rng.normal(size=uv.shape) * 1e-14 * h
+    assert _congruence(uv, h) == _congruence(noisy, h)
+    assert _congruence(np.array([0.0, -0.0]), h) == _congruence(np.array([0.0, 0.0]), h)
+    moved = uv.copy()
+    moved[7] += 1e-3 * h
+    assert _congruence(uv, h) != _congruence(moved, h)
+    assert _congruence(0.25, h) == _congruence(0.25 + 1e-16, h)
