@@ -63,8 +63,6 @@ class Frame:
         Rows: the frame's x, y and z axes in world coordinates (a rotation:
         orthonormal, determinant +1).  A point ``p`` of the model has frame
         coordinates ``axes @ p``.
-    world : bool
-        True when the world axes are kept (``axes`` is the identity).
     aligned : float
         Share of the surface area whose direction lies along one of
         ``axes`` (its planar faces' normals, its axial faces' axes).
@@ -73,9 +71,13 @@ class Frame:
     """
 
     axes: np.ndarray
-    world: bool
     aligned: float
     world_aligned: float
+
+    @property
+    def world(self) -> bool:
+        """Whether the world axes are kept (``axes`` is the identity)."""
+        return bool(np.array_equal(self.axes, WORLD))
 
 
 def surface_directions(solid) -> tuple[np.ndarray, np.ndarray]:
@@ -232,7 +234,7 @@ def model_frame(solid) -> Frame:
     dirs, areas, refs, planar = surface_directions(solid)
     total = float(sum(f.Area() for f in solid.Faces()))
     if areas.shape[0] == 0 or total <= 0:
-        return Frame(WORLD.copy(), True, 0.0, 0.0)
+        return Frame(WORLD.copy(), 0.0, 0.0)
     groups = _groups(dirs, areas, refs, planar)
     world = _aligned(WORLD, groups)
     best, best_w, best_x = None, -1.0, 0.0
@@ -246,8 +248,8 @@ def model_frame(solid) -> Frame:
         if w > best_w * (1 + _WEIGHT_TIE) or x > best_x * (1 + _WEIGHT_TIE):
             best, best_w, best_x = axes, w, x
     if best is None or best_w < world + SWITCH * total:
-        return Frame(WORLD.copy(), True, world / total, world / total)
-    return Frame(best, False, best_w / total, world / total)
+        return Frame(WORLD.copy(), world / total, world / total)
+    return Frame(best, best_w / total, world / total)
 
 
 def in_frame(solid, axes: np.ndarray):

@@ -329,7 +329,8 @@ def _congruence(x, h: float) -> bytes:
     layout": rounded to ``CONGRUENCE_GRID`` h (with -0.0 made 0.0), so that
     two congruent faces are told equal whatever the last bits of their
     coordinates (a turned model's ends differ by 1e-14 h; rounded to 1e-12
-    absolute they were unequal one time in two and got different repairs)."""
+    absolute, a face's thousand coordinates can straddle a rounding boundary
+    and the ends get different repairs)."""
     return (np.round(np.asarray(x, dtype=np.float64) / h / CONGRUENCE_GRID) + 0.0).tobytes()
 
 

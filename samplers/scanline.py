@@ -753,7 +753,7 @@ def scan(
             res.meta,
             **_shape_meta(shape, occ),
             frame=frame.axes.tolist(),
-            directions=(np.asarray(AXES) @ frame.axes).tolist(),
+            directions=frame.axes.tolist(),  # the axes, turned into the world
         )
         return ScanSamples(
             points=res.points @ frame.axes,

@@ -1005,15 +1005,27 @@ def _silenced():
             os.close(fd)
 
 
-def _read_cad(path: Path):
-    """The CadQuery shape in a STEP or BREP file."""
-    import cadquery as cq
+def cad_format(path) -> str:
+    """The CAD format of a file by its extension (one of :data:`CAD_FORMATS`).
 
-    ext = path.suffix.lower()
+    Raises
+    ------
+    ShapeError
+        For any other extension, naming the ones read.
+    """
+    ext = Path(path).suffix.lower()
     if ext not in CAD_FORMATS:
         raise ShapeError(
             f"{path}: unsupported CAD format {ext or '(none)'}; use one of {', '.join(CAD_FORMATS)}"
         )
+    return ext
+
+
+def _read_cad(path: Path):
+    """The CadQuery shape in a STEP or BREP file."""
+    import cadquery as cq
+
+    ext = cad_format(path)
     if not path.is_file():
         raise ShapeError(f"{path}: no such file")
     try:

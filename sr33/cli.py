@@ -177,13 +177,12 @@ def _cmd_sample(args) -> int:
         raise InputError(
             "sample needs a SHAPE: a library name (see sr33 sample --list) or a STEP/BREP file"
         )
-    suffix = Path(args.shape).suffix.lower()
-    from_file = suffix in shapes.CAD_FORMATS
-    if suffix and not from_file:
-        raise InputError(
-            f"{args.shape}: unsupported CAD format {suffix}; use one of "
-            f"{', '.join(shapes.CAD_FORMATS)} (or a library shape name, see sr33 sample --list)"
-        )
+    from_file = bool(Path(args.shape).suffix)
+    if from_file:
+        try:
+            shapes.cad_format(args.shape)
+        except shapes.ShapeError as exc:
+            raise InputError(f"{exc} (or a library shape name, see sr33 sample --list)") from None
     if from_file and args.param:
         raise InputError(f"--param applies to library shapes, not to the CAD file {args.shape}")
     if not args.output:
@@ -286,10 +285,10 @@ def _cmd_validate(args) -> int:
         from .io import TEXT_FORMATS
 
         _check_outputs([(args.json, TEXT_FORMATS, "text")], inputs=[args.mesh, args.truth])
+    tv, tf = read_mesh(args.truth) if args.truth else (None, None)
     if args.truth:
         from sr33.validators.fidelity import hausdorff
 
-        tv, tf = read_mesh(args.truth)
         verdict = homeomorphic(sig, signature(tf, tv.shape[0], points=tv))
         spacing = float(np.median(cKDTree(v).query(v, 2)[0][:, 1]))
         fid = hausdorff(v, f, tv, tf, spacing=spacing, samples=5000)
@@ -313,8 +312,7 @@ def _cmd_validate(args) -> int:
         # part of the mesh's check
         from sr33.validators.conditions import condition_iii
 
-        truth = read_mesh(args.truth) if args.truth else (None, None)
-        cond = condition_iii(pts, *truth, quiet=args.quiet)
+        cond = condition_iii(pts, tv, tf, quiet=args.quiet)
         rows.append(("points' Condition III", cond.line()))
         doc["condition_iii"] = {
             "method": cond.method,

@@ -302,7 +302,7 @@ def _solve_component(
 
     ``links`` are the samples whose link circuit is added up front; it is
     extended with the samples cut lazily.  Returns (new state or None,
-    proven, cuts).
+    proven, cuts, the budget spent in seconds).
     """
     from ortools.sat.python import cp_model
 

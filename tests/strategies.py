@@ -241,26 +241,20 @@ def _dihedral_features(vertices: np.ndarray, triangles: np.ndarray) -> set[str]:
     """'acute edge' where the truth mesh turns by more than 100 degrees across
     an edge (an interior angle below 80), 'reflex edge' where it turns
     inwards by more than 20 (a concave sharp edge)."""
-    p = vertices[triangles]
-    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
-    pairs: dict[tuple[int, int], list[int]] = {}
-    for t, tri in enumerate(triangles.tolist()):
-        for i in range(3):
-            a, b = tri[i], tri[(i + 1) % 3]
-            pairs.setdefault((min(a, b), max(a, b)), []).append(t)
+    from sr33.validators.fidelity import dihedral_pairs
+
+    v = np.asarray(vertices, dtype=np.float64)
+    t = np.asarray(triangles, dtype=np.int64)
+    edge, fa, fb, cos = dihedral_pairs(v, t)
     out = set()
-    for (a, b), ts in pairs.items():
-        if len(ts) != 2:
-            continue
-        s, t = ts
-        cos = float(n[s] @ n[t])
-        if cos < np.cos(np.radians(100)):
-            out.add("acute edge")
-        # concave: the other triangle's far corner lies outside s's plane
-        far = [v for v in triangles[t] if v not in (a, b)][0]
-        if cos < np.cos(np.radians(20)) and float(n[s] @ (vertices[far] - vertices[a])) > 0:
-            out.add("reflex edge")
+    if (cos < np.cos(np.radians(100))).any():
+        out.add("acute edge")
+    # concave: fb's far corner lies outside fa's plane
+    n = np.cross(v[t[fa, 1]] - v[t[fa, 0]], v[t[fa, 2]] - v[t[fa, 0]])
+    far = t[fb].sum(axis=1) - edge.sum(axis=1)
+    outside = (n * (v[far] - v[edge[:, 0]])).sum(axis=1) > 0
+    if (outside & (cos < np.cos(np.radians(20)))).any():
+        out.add("reflex edge")
     return out
 
 

@@ -163,8 +163,9 @@ def test_a_turned_model_in_its_upright_frame_scans_as_the_upright_one():
 def test_congruent_faces_are_told_equal_whatever_their_last_bits():
     """repair_planar_faces gives congruent faces (a prism's two ends) one
     answer; their layouts are compared on a grid of 1e-6 h, so that a turned
-    model's ends, 1e-14 h apart, are still equal (rounded to 1e-12 absolute
-    they were unequal about one time in two), and -0.0 is 0.0."""
+    model's ends, 1e-14 h apart, are still equal (rounded to 1e-12 absolute,
+    a thousand coordinates 4e-16 apart straddle a rounding boundary about
+    one time in three), and -0.0 is 0.0."""
     from sr33.samplers.layers import _congruence
 
     h = 0.04
