@@ -146,9 +146,9 @@ def goes_round(face) -> bool:
 
 
 def revolution_axis(face):
-    """(point, unit direction) of a cone's, cylinder's or sphere's axis
-    (a sphere's point is its centre)."""
+    """(point, unit direction) of a cone's, cylinder's, sphere's or torus's
+    axis (a sphere's and a torus's point is its centre)."""
     g = face._geomAdaptor()
-    kind = {"CONE": "Cone", "CYLINDER": "Cylinder"}.get(face.geomType(), "Sphere")
+    kind = {"CONE": "Cone", "CYLINDER": "Cylinder", "TORUS": "Torus"}.get(face.geomType(), "Sphere")
     pos = getattr(g, kind)().Position()
     return np.array(pos.Location().Coord()), np.array(pos.Direction().Coord())

@@ -48,6 +48,7 @@ from .faces import (
     steps,
 )
 from .repair import GAP, MOVABLE, Repaired, copies, repair, split_corners
+from .rings import ring_positions
 from .samples import Samples
 
 LAYER = 2.5  # samples within this many h of a circular edge may move
@@ -1094,20 +1095,25 @@ def _meridian(face, o, axis, count: int = 2000):
 def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     """Lay a closed body of revolution out in rings that keep their columns.
 
-    Applies when every face is a full cone or sphere about one axis and the
-    faces meet along smooth circles (the revolved cone tip): the meridian
-    from pole to pole is cut into ``round(S / h)`` equal arc-length steps,
-    every step a ring (a parallel); the widest ring gets evenly spaced
-    columns about h apart (a count that halves down to 3 to 5 columns,
-    :func:`halving_count`), and the rings towards either pole keep the
-    columns of the ring before them, ending crowded ones as on a cone
-    (:func:`lattice_cone_faces`).  Samples on the axis (the apex, the
+    Applies when every face is a full cone, sphere or torus about one axis
+    and the faces meet along smooth circles (a ball, the revolved cone tip,
+    a torus): the meridian, from pole to pole or round a torus's circle, is
+    cut into ``round(S / h)`` arc-length steps, every step a ring (a
+    parallel); the widest ring gets evenly spaced columns about h apart (a
+    count that halves down to 3 to 5 columns, :func:`halving_count`), and
+    the rings away from it keep the columns of the ring before them, every
+    other one ending where the gap has shrunk to
+    :data:`~sr33.samplers.rings.HALVING_GAP` row steps: those rings stand
+    exactly there (:func:`sr33.samplers.rings.ring_positions`).  Within
+    ``POLE_REACH`` steps of a pole the rings are one step apart, end their
+    crowded columns as on a cone (:func:`lattice_cone_faces`) and are
+    repaired (:func:`_repair_pole`).  Samples on the axis (the apex, the
     poles) stay; every other sample of the body is replaced (the seam's
     vertices are not features of the surface).  Each ring sample is the
     exact meridian point turned about the axis, so it lies on the surface.
     """
     faces = occ.Faces()
-    if not faces or any(f.geomType() not in ("CONE", "SPHERE") for f in faces):
+    if not faces or any(f.geomType() not in ("CONE", "SPHERE", "TORUS") for f in faces):
         return []
     if not all(goes_round(f) for f in faces):
         return []
@@ -1130,6 +1136,13 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     seg = [np.r_[0.0, np.cumsum(np.hypot(np.diff(q[2]), np.diff(q[3])))] for q in parts]
     starts = np.cumsum([0.0] + [x[-1] for x in seg[:-1]])
     total = float(starts[-1] + seg[-1][-1])
+    first, last = parts[0], parts[-1]
+    closed = bool(
+        math.hypot(first[2][0] - last[2][-1], first[3][0] - last[3][-1]) <= tol
+        and min(float(q[3].min()) for q in parts) > tol
+    )
+    if not closed and (first[3][0] > tol or last[3][-1] > tol):
+        return []  # the meridian neither closes nor ends on the axis
     rows = steps(total, h, least=2)
     t = total / rows
     umin = [f._uvBounds()[0] for f in faces]
@@ -1143,27 +1156,46 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         z = float(dot(p, axis))
         return fi, z, float(norm(p - z * axis))
 
-    ring = [at(j * t) for j in range(1, rows)]  # (face, axial, radial) per row 1 .. rows - 1
+    mer_s = np.concatenate([starts[k] + x for k, x in enumerate(seg)])
+    mer_r = np.concatenate([q[3] for q in parts])
+    m = halving_count(2 * math.pi * float(mer_r.max()) / h)
+    plan = ring_positions(
+        mer_s, mer_r, t, m, closed=closed, keep=(0, 0) if closed else (POLE_REACH, POLE_REACH)
+    )
+    if closed:  # round the torus from its widest point
+        w = float(mer_s[int(np.argmax(mer_r))])
+        ring = [at((w + x) % total) for x in plan.at]
+    else:
+        ring = [at(float(x)) for x in plan.at]
     radial = np.array([r for _, _, r in ring])
-    widest = int(np.argmax(radial))
+    widest = plan.widest
     ex = perpendicular(axis)
     ey = np.cross(axis, ex)
-    m = halving_count(2 * math.pi * radial[widest] / h)
+    # the rings inside a pole's rim end their columns by the cone's rule (the
+    # rim itself, fixed in the pole's repair, only halves by design)
+    inner = POLE_REACH - 1
+    pole_zone = set() if closed else set(range(inner)) | set(range(len(ring) - inner, len(ring)))
     columns = {widest: 2 * math.pi * np.arange(m) / m}
+    n_ring = len(ring)
     for step in (-1, 1):
         ang = columns[widest]
         j = widest + step
-        while 0 <= j < len(ring):
-            ang = _end_columns(ang, radial[j], t)
-            if (j == 0 or j == len(ring) - 1) and ang.size > 5:
+        # round a torus each way from the widest ring to the narrowest
+        while (0 <= j < n_ring) if not closed else (j - step) % n_ring != plan.meet:
+            jj = j % n_ring
+            if plan.halves[jj]:
+                ang = ang[::2]
+            elif jj in pole_zone:
+                ang = _end_columns(ang, radial[jj], t)
+            if not closed and (jj == 0 or jj == n_ring - 1) and ang.size > 5:
                 ang = ang[::2]  # the ring round a pole: at most 5 columns (see halving_count)
-            columns[j] = ang
+            columns[jj] = ang
             j += step
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     pts, ids, fids = [], [], []
     poles: list[int] = []
     reports: list[dict] = []
-    for end in (0, 1):
+    for end in () if closed else (0, 1):
         pole_rows, p_ang, p_row, report = _repair_pole(ring, columns, faces, t, end)
         if report is None:
             continue

@@ -317,6 +317,18 @@ def _make_cylinder(p):
     return cq.Solid.makeCylinder(p["radius"], h, pnt=cq.Vector(0, 0, -h / 2))
 
 
+def _make_sphere(p):
+    import cadquery as cq
+
+    return cq.Solid.makeSphere(p["radius"], angleDegrees1=-90, angleDegrees2=90)
+
+
+def _make_torus(p):
+    import cadquery as cq
+
+    return cq.Solid.makeTorus(p["major_radius"], p["minor_radius"])
+
+
 def _make_star_prism(p):
     ro, ri = p["outer_radius"], p["inner_radius"]
     pts = []
@@ -445,6 +457,15 @@ def _check_cylinder(p):
     _positive(p, "radius", "height")
 
 
+def _check_sphere(p):
+    _positive(p, "radius")
+
+
+def _check_torus(p):
+    _positive(p, "major_radius", "minor_radius")
+    _less(p, "minor_radius", p["major_radius"], "major_radius")
+
+
 def _check_star_prism(p):
     _positive(p, "outer_radius", "inner_radius", "height")
     _less(p, "inner_radius", p["outer_radius"], "outer_radius")
@@ -542,6 +563,19 @@ _SPECS: dict[str, _Spec] = {
         _check_cylinder,
         _make_cylinder,
     ),
+    "sphere": _Spec(
+        "ball: one smooth closed face with two poles, no feature at all (Theorem 2's case)",
+        {"radius": 0.5},
+        _check_sphere,
+        _make_sphere,
+    ),
+    "torus": _Spec(
+        "torus: the tube of the given minor radius round a circle of the major radius; "
+        "smooth, genus 1",
+        {"major_radius": 0.5, "minor_radius": 0.2},
+        _check_torus,
+        _make_torus,
+    ),
     "star_prism": _Spec(
         "5-pointed star extruded along z: convex and reflex sharp edges",
         {"outer_radius": 0.6, "inner_radius": 0.25, "height": 0.3},
@@ -587,7 +621,7 @@ def shape_names() -> list[str]:
     --------
     >>> names = shape_names()
     >>> len(names), names[:3]
-    (14, ['block_two_holes', 'box_hole', 'cone'])
+    (16, ['block_two_holes', 'box_hole', 'cone'])
     """
     return sorted(_SPECS, key=str.lower)
 

@@ -14,7 +14,7 @@ from sr33.validators.fidelity import surface_points  # noqa: E402
 
 NAMES = shapes.shape_names()
 # default samplings quick enough for `make test`; the others run in `make check`
-QUICK = {"cube", "L_sheet", "pyramid", "square_ring", "box_hole", "cylinder", "fillet_box"}
+QUICK = {"cube", "L_sheet", "pyramid", "square_ring", "box_hole", "cylinder", "fillet_box", "torus"}
 
 
 def by_speed(names):
@@ -525,8 +525,12 @@ def test_round_faces_are_rings_without_bad_triangles(sampled, name):
 
 @pytest.mark.parametrize(
     "name",
-    by_speed(["cube", "L_sheet"])
-    + [pytest.param(n, marks=pytest.mark.slow) for n in NAMES if n not in ("cube", "L_sheet")],
+    by_speed(["cube", "L_sheet", "torus"])
+    + [
+        pytest.param(n, marks=pytest.mark.slow)
+        for n in NAMES
+        if n not in ("cube", "L_sheet", "torus")
+    ],
 )
 def test_shapes_meet_condition_iii(checked, name):
     """No sample of any library shape's default sampling breaks Condition
@@ -538,10 +542,13 @@ def test_shapes_meet_condition_iii(checked, name):
     0.805); pyramid: one lattice, the ties across its lateral edges
     decided (worst 0.830; 0.866 with the ties left, 2.09% violating with
     the scan rows at height 0.8); cone: a designed fan of two spokes
-    round the apex (worst 0.859);
+    round the apex (worst 0.859); sphere and torus: rings halving where
+    their gap is 0.707 row steps (worst 0.836, 0.830);
     block_two_holes: its one near tie decided by the angle test (worst
     0.847, 0.870 by the labels alone); cone_tip: an uneven fan of three
-    spokes round its apex (worst 0.863); conebox: its cone's stuck ring
+    spokes round its apex, its ball's rings halving by design (worst 0.845;
+    0.862 where they halved wherever the gap fell below 0.8 row steps);
+    conebox: its cone's stuck ring
     repair run again over a wider band, its top's stuck boundary layer
     again with wider cells allowed (worst 0.865; 0.29% of the samples
     violating without either); wedge: its ends' edge samples slide and its
@@ -594,11 +601,30 @@ def test_rings_round_a_pole_and_an_apex_are_repaired(sampled, checked):
     for end in (np.argmin, np.argmax):
         pole = r.points[on_axis][end(r.points[on_axis, 2])]
         near = np.linalg.norm(r.points - pole, axis=1) < (POLE_REACH + 2) * h
-        assert near.sum() > 150 and not bad[near].any()
+        # (the ball's last designed halving stands two steps outside its pole's rim:
+        # 139 samples within reach, where rings halving anywhere left 150-odd)
+        assert near.sum() > 100 and not bad[near].any()
     assert math.isfinite(rep.worst_ratio[on_axis].max())  # apex and pole in triangles
 
 
-@pytest.mark.parametrize("name", by_speed(["cylinder", "square_ring", "cone_tip"]))
+@pytest.mark.parametrize("name", by_speed(["torus", "sphere", "cone_tip"]))
+def test_bodies_of_revolution_meet_condition_iii_with_a_margin(sampled, checked, name):
+    """Rings of a body of revolution halve where their gap is
+    ``HALVING_GAP`` row steps, with the steps of ``HALVING_STEPS`` round
+    them (samplers.rings): the geodesic check's worst ratio stays at 0.85
+    or below (issue 23's margin), where halving wherever the gap fell below
+    0.8 row steps gave the ball 0.864 (352 samples above 0.85), cone_tip
+    0.862 and the torus's scan rows 1.000 (3,221 samples breaking III-ii)."""
+    s, r = sampled[name]
+    rep = checked(name)
+    assert rep.max_degree <= 33
+    assert np.nanmax(rep.worst_ratio) <= 0.85
+    assert np.isfinite(rep.worst_ratio).all()  # every sample in a DT_M triangle
+    rings = [x for x in r.meta["repairs"] if x["kind"] == "revolved rings"]
+    assert len(rings) == 1
+
+
+@pytest.mark.parametrize("name", by_speed(["cylinder", "square_ring", "cone_tip", "torus"]))
 def test_ring_laid_shapes_reconstruct_with_their_topology(sampled, name):
     from sr33 import reconstruct
 
@@ -711,3 +737,21 @@ def test_partial_spheres_with_sharp_rims_are_repaired(sampled):
     assert spheres[0]["added"] + spheres[0]["removed"] > 0
     _, r = sampled["fillet_box"]
     assert not [x for x in r.meta["repairs"] if x["kind"] == "sphere"]
+
+
+def test_a_turned_torus_keeps_its_rings_and_its_margin():
+    """The rings follow the torus's own axis, not the scan directions: turned
+    by (37°, -112°, 71°) the same number of samples, every one on the
+    surface, and the geodesic check's worst ratio at 0.85 or below."""
+    pytest.importorskip("potpourri3d")
+    from sr33.validators.conditions import sample_conditions
+    from sr33.validators.fidelity import distance_to_surface
+
+    upright = scan(shapes.build("torus"))
+    s = shapes.build("torus", rotate_x=37.0, rotate_y=-112.0, rotate_z=71.0)
+    r = scan(s)
+    assert r.points.shape == upright.points.shape
+    d = distance_to_surface(r.points, s.truth_vertices, s.truth_triangles)
+    assert d.max() < 0.05 * r.meta["spacing"]  # up to the truth's sagitta
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    assert rep.max_degree <= 33 and np.nanmax(rep.worst_ratio) <= 0.85

@@ -1,0 +1,200 @@
+"""Where the rings of a body of revolution stand along its meridian, and
+where their columns halve.
+
+A body of revolution is laid out in rings (parallels, one row each) whose
+columns continue from ring to ring (:func:`sr33.samplers.layers.lattice_revolved_body`):
+the cells are rectangles, gap by row step, whose Delaunay triangles meet
+Condition III-ii while the gap stays within 0.62 to 1.61 row steps.  As
+the rings shrink towards the axis, every other column ends; the triangles
+where a ring halves, and the rectangles after it, meet the condition only
+when the gap at the halving is close to ``HALVING_GAP`` row steps (flat
+estimate: the halving triangle's ratio ``sqrt(x^2 + 1) / 2x`` falls with
+the gap x, the merged cells' ``2x / sqrt(4x^2 + 1)`` rises with it; they
+balance at x = 0.751, both 0.832).  Rings one row step apart hit that gap
+only by chance (on a ball of radius 20 h, a ring's radius changes by up
+to 7 % a step at mid-latitude, the window for a ratio of 0.845 is ±2 %),
+so :func:`ring_positions` puts a ring exactly where the gap reaches it, one
+row step from its neighbours, and evens the rest of the way out over the
+steps between halvings.
+
+Plain numpy; the meridian is given as arc lengths and radii.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: a ring's columns halve where their gap is this many row steps
+HALVING_GAP = 0.707
+#: the steps before and after a halving ring, times the row step: nearer on
+#: the side of the full columns and farther on the side of the merged ones,
+#: both ratios fall (flat estimate at the gap 0.751: 0.780 and 0.807)
+HALVING_STEPS = (0.8, 1.0)
+
+
+@dataclass(frozen=True)
+class RingPlan:
+    """Rings along a meridian (:func:`ring_positions`).
+
+    Attributes
+    ----------
+    at : (n,) float64
+        Arc length of every ring from the meridian's start, increasing (on a
+        closed meridian, from the widest ring, in ``[0, length)``).
+    halves : (n,) bool
+        The ring keeps every other column of its neighbour nearer the widest
+        ring (the first of equal ones, round a closed meridian).
+    widest : int
+        Index of the widest ring, where the columns start.
+    meet : int
+        On a closed meridian, the narrowest ring, where the columns from
+        either side of the widest meet (-1 on an open one).
+    """
+
+    at: np.ndarray
+    halves: np.ndarray
+    widest: int
+    meet: int = -1
+
+
+def _crossing(s: np.ndarray, rho: np.ndarray, a: float, b: float, level: float) -> float | None:
+    """The first arc length from ``a`` towards ``b`` where the radius falls
+    to ``level`` (linear between the meridian's points), or None."""
+    lo, hi = min(a, b), max(a, b)
+    inner = (s > lo) & (s < hi)
+    ss = np.r_[a, s[inner][:: 1 if b > a else -1], b]
+    rr = np.interp(ss, s, rho)
+    below = np.flatnonzero(rr <= level)
+    if below.size == 0:
+        return None
+    k = int(below[0])
+    if k == 0:
+        return float(a)
+    f = (rr[k - 1] - level) / (rr[k - 1] - rr[k])
+    return float(ss[k - 1] + f * (ss[k] - ss[k - 1]))
+
+
+def _fill(length: float, t: float, first: float, last: float) -> list[float]:
+    """Distances of the rings strictly between two rings ``length`` apart:
+    a step ``first`` after the first and ``last`` before the second, the
+    rest of the way in equal steps as near ``t`` as a whole number of them
+    gets (all equal where the way is under four steps)."""
+    n = max(1, round(length / t))
+    if n <= 3:
+        return [length * k / n for k in range(1, n)]
+    mid = (length - first - last) / (n - 2)
+    return [first] + [first + mid * k for k in range(1, n - 2)] + [length - last]
+
+
+def _side(s, rho, start: float, stop: float, step: float, columns: int, gap: float, rim: bool):
+    """Rings from the one at ``start`` (the widest, excluded) to the one at
+    ``stop`` (included), halving where the gap reaches ``gap`` row steps:
+    {position: halves}.  Halvings stand two steps apart at least; one due
+    within two steps of ``stop`` comes two steps before it where ``stop``
+    is a pole's ``rim`` (whose rings inside are repaired, not the rim), and
+    is left out otherwise (the narrowest ring of a torus, where the gap
+    then stays just under ``gap``)."""
+    sign = 1.0 if stop >= start else -1.0
+    anchors = [start]
+    m = columns
+    while m >= 6:
+        x = _crossing(s, rho, anchors[-1], stop, gap * step * m / (2 * math.pi))
+        if x is not None and rim and abs(stop - x) < 2 * step:
+            x = stop - sign * 2 * step
+        # a halving ring has a row step on either side before the next anchor
+        if x is None or abs(stop - x) < 2 * step - 1e-9 * step or abs(x - anchors[-1]) < 2 * step:
+            break
+        anchors.append(x)
+        m //= 2
+    anchors.append(stop)
+    before, after = (f * step for f in HALVING_STEPS)
+    out: dict[float, bool] = {}
+    for k, (a, b) in enumerate(zip(anchors[:-1], anchors[1:])):
+        first = after if k > 0 else step  # after a halving
+        last = before if k < len(anchors) - 2 else step  # before one
+        for d in _fill(abs(b - a), step, first, last):
+            out[a + sign * d] = False
+        out[b] = 0 < k + 1 < len(anchors) - 1
+    return out
+
+
+def ring_positions(
+    s: np.ndarray,
+    rho: np.ndarray,
+    step: float,
+    columns: int,
+    *,
+    closed: bool = False,
+    keep: tuple[int, int] = (0, 0),
+    gap: float = HALVING_GAP,
+) -> RingPlan:
+    """Rings along a meridian, halving their columns where the gap is ``gap`` row steps.
+
+    Parameters
+    ----------
+    s, rho : (p,) float64
+        The meridian: arc lengths (increasing from 0 to its length) and the
+        distance from the axis at each.  A closed meridian (a torus's
+        circle) repeats its first point last, ``s[-1]`` being its length.
+    step : float
+        Row step t; an open meridian's length is a whole number of them.
+    columns : int
+        Columns on the widest ring (a count that halves, see
+        :func:`sr33.samplers.chart.halving_count`).
+    closed : bool
+        The meridian is a closed curve off the axis (no poles).
+    keep : (int, int)
+        On an open meridian, rings kept one ``step`` apart at either end
+        (round a pole, where the columns end by their own rule and are
+        repaired); the rings between are designed.
+    gap : float
+        Gap (times ``step``) at which a ring's columns halve.
+
+    Returns
+    -------
+    RingPlan
+        An open meridian's rings run from ``step`` after its start to
+        ``step`` before its end (the poles are not rings); with fewer than
+        two rows between the kept ones, all rings are one ``step`` apart and
+        none halves by design.
+    """
+    s = np.asarray(s, dtype=np.float64)
+    rho = np.asarray(rho, dtype=np.float64)
+    length = float(s[-1])
+    if closed:
+        # unrolled so that the widest point is at 0, one turn either way
+        w = float(s[int(np.argmax(rho[:-1]))])
+        ss = np.r_[s[:-1] - w - length, s[:-1] - w, s[:-1] - w + length]
+        rr = np.r_[rho[:-1], rho[:-1], rho[:-1]]
+        order = np.argsort(ss, kind="stable")
+        ss, rr = ss[order], rr[order]
+        half = (ss >= 0.0) & (ss <= length)
+        narrow = float(ss[half][int(np.argmin(rr[half]))])
+        at = {0.0: False}
+        at.update(_side(ss, rr, 0.0, narrow, step, columns, gap, False))
+        back = _side(ss, rr, 0.0, narrow - length, step, columns, gap, False)
+        for p, halves in back.items():
+            if p - (narrow - length) > 1e-9 * step:  # the narrowest ring once
+                at[p + length] = halves
+        pos = np.array(sorted(at))
+        meet = int(np.argmin(np.abs(pos - narrow)))
+        return RingPlan(pos, np.array([at[p] for p in sorted(at)]), 0, meet)
+    rows = round(length / step)
+    uniform = np.arange(1, rows) * step
+    lo, hi = keep[0] - 1, rows - 1 - keep[1]  # the designed rings' first and last index
+    if hi - lo < 2 or lo < 0:
+        return RingPlan(
+            uniform, np.zeros(uniform.size, bool), int(np.argmax(np.interp(uniform, s, rho)))
+        )
+    wi = lo + int(np.argmax(np.interp(uniform[lo : hi + 1], s, rho)))
+    w = float(uniform[wi])
+    at = {w: False}
+    for stop in (float(uniform[lo]), float(uniform[hi])):
+        at.update(_side(s, rho, w, stop, step, columns, gap, True))
+    mid = sorted(at)
+    pos = np.r_[uniform[:lo], mid, uniform[hi + 1 :]]
+    halves = np.r_[np.zeros(lo, bool), [at[p] for p in mid], np.zeros(uniform.size - hi - 1, bool)]
+    return RingPlan(pos, halves.astype(bool), lo + mid.index(w))
