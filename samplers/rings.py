@@ -52,12 +52,16 @@ class RingPlan:
     meet : int
         On a closed meridian, the narrowest ring, where the columns from
         either side of the widest meet (-1 on an open one).
+    moved : int
+        Halvings due within two steps of a kept end's first ring, put two
+        steps before it (at a gap wider than the design's).
     """
 
     at: np.ndarray
     halves: np.ndarray
     widest: int
     meet: int = -1
+    moved: int = 0
 
 
 def _crossing(s: np.ndarray, rho: np.ndarray, a: float, b: float, level: float) -> float | None:
@@ -81,10 +85,15 @@ def _fill(length: float, t: float, first: float, last: float) -> list[float]:
     """Distances of the rings strictly between two rings ``length`` apart:
     a step ``first`` after the first and ``last`` before the second, the
     rest of the way in equal steps as near ``t`` as a whole number of them
-    gets (all equal where the way is under four steps)."""
+    gets.  Two steps in all honour the one that differs from ``t`` (the
+    step before a halving first), one step nothing."""
     n = max(1, round(length / t))
-    if n <= 3:
-        return [length * k / n for k in range(1, n)]
+    if n == 1:
+        return []
+    if n == 2:
+        if last != t:
+            return [length - last]
+        return [first] if first != t else [length / 2]
     mid = (length - first - last) / (n - 2)
     return [first] + [first + mid * k for k in range(1, n - 2)] + [length - last]
 
@@ -92,18 +101,20 @@ def _fill(length: float, t: float, first: float, last: float) -> list[float]:
 def _side(s, rho, start: float, stop: float, step: float, columns: int, gap: float, rim: bool):
     """Rings from the one at ``start`` (the widest, excluded) to the one at
     ``stop`` (included), halving where the gap reaches ``gap`` row steps:
-    {position: halves}.  Halvings stand two steps apart at least; one due
-    within two steps of ``stop`` comes two steps before it where ``stop``
-    is a pole's ``rim`` (whose rings inside are repaired, not the rim), and
-    is left out otherwise (the narrowest ring of a torus, where the gap
-    then stays just under ``gap``)."""
+    {position: halves}, and how many halvings were moved.  Halvings stand
+    two steps apart at least; one due within two steps of ``stop`` comes
+    two steps before it (moved) where ``stop`` is a pole's ``rim`` (whose
+    rings inside are repaired, not the rim), and is left out otherwise (the
+    narrowest ring of a torus, where the gap then stays just under ``gap``)."""
     sign = 1.0 if stop >= start else -1.0
     anchors = [start]
     m = columns
+    moved = 0
     while m >= 6:
         x = _crossing(s, rho, anchors[-1], stop, gap * step * m / (2 * math.pi))
         if x is not None and rim and abs(stop - x) < 2 * step:
             x = stop - sign * 2 * step
+            moved += 1
         # a halving ring has a row step on either side before the next anchor
         if x is None or abs(stop - x) < 2 * step - 1e-9 * step or abs(x - anchors[-1]) < 2 * step:
             break
@@ -118,7 +129,7 @@ def _side(s, rho, start: float, stop: float, step: float, columns: int, gap: flo
         for d in _fill(abs(b - a), step, first, last):
             out[a + sign * d] = False
         out[b] = 0 < k + 1 < len(anchors) - 1
-    return out
+    return out, moved
 
 
 def ring_positions(
@@ -174,8 +185,8 @@ def ring_positions(
         half = (ss >= 0.0) & (ss <= length)
         narrow = float(ss[half][int(np.argmin(rr[half]))])
         at = {0.0: False}
-        at.update(_side(ss, rr, 0.0, narrow, step, columns, gap, False))
-        back = _side(ss, rr, 0.0, narrow - length, step, columns, gap, False)
+        at.update(_side(ss, rr, 0.0, narrow, step, columns, gap, False)[0])
+        back = _side(ss, rr, 0.0, narrow - length, step, columns, gap, False)[0]
         for p, halves in back.items():
             if p - (narrow - length) > 1e-9 * step:  # the narrowest ring once
                 at[p + length] = halves
@@ -192,9 +203,12 @@ def ring_positions(
     wi = lo + int(np.argmax(np.interp(uniform[lo : hi + 1], s, rho)))
     w = float(uniform[wi])
     at = {w: False}
+    moved = 0
     for stop in (float(uniform[lo]), float(uniform[hi])):
-        at.update(_side(s, rho, w, stop, step, columns, gap, True))
+        side, k = _side(s, rho, w, stop, step, columns, gap, True)
+        at.update(side)
+        moved += k
     mid = sorted(at)
     pos = np.r_[uniform[:lo], mid, uniform[hi + 1 :]]
     halves = np.r_[np.zeros(lo, bool), [at[p] for p in mid], np.zeros(uniform.size - hi - 1, bool)]
-    return RingPlan(pos, halves.astype(bool), lo + mid.index(w))
+    return RingPlan(pos, halves.astype(bool), lo + mid.index(w), -1, moved)

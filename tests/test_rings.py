@@ -81,3 +81,38 @@ def test_an_open_meridian_keeps_its_pole_rings_one_step_apart():
     short = ring_positions(s, rho, s[-1] / 12, m, keep=(6, 6))
     np.testing.assert_allclose(np.diff(short.at), s[-1] / 12, rtol=1e-9)
     assert not short.halves.any()
+
+
+def test_a_cone_from_its_rim_halves_at_the_gap_and_reports_moved_halvings():
+    """A cone's straight meridian from its rim (s = 0) to its apex: the
+    halvings stand where the gap is HALVING_GAP row steps; one due within
+    two steps of the kept apex rows is moved two steps before them and
+    counted, so that a caller can choose the apex rows that move none."""
+    slant, radius, t, m = 1.58, 0.5, 0.025, 128
+    s, rho = np.array([0.0, slant]), np.array([radius, 0.0])
+    t = slant / round(slant / t)
+    found = {}
+    for keep in range(6, 14):
+        plan = ring_positions(s, rho, t, m, keep=(1, keep))
+        assert plan.widest == 0  # the ring next to the rim
+        np.testing.assert_allclose(plan.at[-keep + 1 :], slant - np.arange(keep - 1, 0, -1) * t)
+        cols = m
+        for j in np.flatnonzero(plan.halves):
+            gap = 2 * math.pi * np.interp(plan.at[j], s, rho) / cols
+            if plan.moved == 0:
+                np.testing.assert_allclose(gap, HALVING_GAP * t, rtol=1e-9)
+            else:
+                assert gap >= HALVING_GAP * t * (1 - 1e-9)
+            np.testing.assert_allclose(plan.at[j] - plan.at[j - 1], HALVING_STEPS[0] * t)
+            cols //= 2
+        found[keep] = plan.moved
+    assert set(found.values()) == {0, 1}  # both happen over these apex zones
+
+
+def test_fill_honours_the_step_before_a_halving():
+    from sr33.samplers.rings import _fill
+
+    assert _fill(0.9, 1.0, 1.0, 1.0) == []
+    np.testing.assert_allclose(_fill(2.1, 1.0, 1.0, 0.8), [1.3])
+    np.testing.assert_allclose(_fill(2.0, 1.0, 1.0, 1.0), [1.0])
+    np.testing.assert_allclose(_fill(5.0, 1.0, 1.0, 0.8), [1.0, 2.0666666, 3.1333333, 4.2])
