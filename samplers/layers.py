@@ -58,6 +58,12 @@ END_MERGED = 1.65  # ... unless the merged gap would exceed this
 NARROW = 0.6  # ... or it ends anyway once a gap is below this (times the row step)
 LINE_EDITS = 40  # edits on a face with slanted straight edges only
 FOLLOW_EDITS = 160  # ... when some of them slide with the columns of the face across
+#: a face's repair whose worst ratio (in its chart) is this or more is stuck:
+#: retried wider, its corners split, the faces next to it redone.  At √3/2
+#: (only a broken condition) conebox's top kept 0.853 by the geodesic check
+#: (9 samples above issue 23's margin of 0.85); at 0.85 it reaches 0.843,
+#: sampled in 69 s instead of 20, and no other library shape changes
+STUCK = 0.85
 RETRY_WIDE = 1.2  # a stuck face's repair runs again with circumradii up to this (times h)
 FEW_BAD = 10  # a repair left with at most this many bad triangles gets its corners split
 
@@ -363,9 +369,9 @@ def repair_planar_faces(
     both rims span (:func:`lattice_cylinder_faces` needs equal angles; the
     wall kept its scan rows, and cutcube 80 DT_M triangles above √3/2 across
     the rims).  Where the repair of a face bounded by whole circles is stuck with a
-    ratio at or above √3/2, it runs again allowing cells of circumradius up
+    ratio at or above ``STUCK``, it runs again allowing cells of circumradius up
     to ``RETRY_WIDE`` h, and the lower worst ratio is kept (conebox's top:
-    0.879 -> 0.853).  A repair still at or above √3/2 with at most
+    0.879 -> 0.853).  A repair still at or above ``STUCK`` with at most
     ``FEW_BAD`` triangles above its margin gets the angles at its fixed
     samples split (:func:`sr33.samplers.repair.split_corners`; star prism's
     reflex corners: 0.938 -> 0.850, none of its samples violating III-ii
@@ -375,7 +381,7 @@ def repair_planar_faces(
     get one answer even where a gap was filled on one of them only (a
     prism's two ends; their sides' columns run straight from one to the
     other).  A face still left with at most ``FEW_BAD`` triangles at or
-    above √3/2 is repaired once more from that answer (``again``;
+    above ``STUCK`` is repaired once more from that answer (``again``;
     fillet_box's bottom: two of 0.884 where its corners' arcs meet the
     rows, none after the second run).  Returns one report per repaired
     face.
@@ -507,11 +513,11 @@ def repair_planar_faces(
             # stuck: allow wider cells (only round whole circles: on cutcube's
             # face whose scoop arc ends on the cube's edge it opened the
             # reconstruction there, 5 open edges)
-            if arcs and all(a.closed for a in arcs) and done[key].worst >= SQRT3_2:
+            if arcs and all(a.closed for a in arcs) and done[key].worst >= STUCK:
                 again = repair(uv, free, h, wide=RETRY_WIDE, **args)
                 if again.worst < done[key].worst:
                     done[key] = again
-            if done[key].worst >= SQRT3_2 and done[key].bad <= FEW_BAD:
+            if done[key].worst >= STUCK and done[key].bad <= FEW_BAD:
                 done[key] = split_corners(uv, free, h, done[key], **args)
         r = done[key]
         if outline is not None and outline not in outlines:
@@ -537,7 +543,7 @@ def repair_planar_faces(
             if a.wall >= 0 and a.wall not in walls:
                 walls[a.wall] = pts3[rim & (a.distance(r.uv) < tol)]
     _follow_columns(s, shifts, faces, tol)
-    stuck = {x["face"] for x in reports if x["worst"] >= SQRT3_2 and x["bad"] <= FEW_BAD}
+    stuck = {x["face"] for x in reports if x["worst"] >= STUCK and x["bad"] <= FEW_BAD}
     if again and stuck:
         rest = set(range(len(faces))) - stuck
         redone = {
