@@ -534,38 +534,39 @@ def test_round_faces_are_rings_without_bad_triangles(sampled, name):
 )
 def test_shapes_meet_condition_iii(checked, name):
     """No sample of any library shape's default sampling breaks Condition
-    III by the geodesic check: every sample in a DT_M triangle (none left
-    out, as a cone's apex was when its cell's corners fell between the
-    truth's vertices) and every ratio below √3/2.  cube, L_sheet: plain
-    lattices (0.707); box_hole and cylinder: boundary layers and walls
-    (0.832, 0.824); square_ring: annuli in rings, walls as the lattice of their rims (worst
-    0.805); pyramid: one lattice, the ties across its lateral edges
-    decided (worst 0.830; 0.866 with the ties left, 2.09% violating with
-    the scan rows at height 0.8); cone: a designed fan of two spokes
-    round the apex, rings halving by design (worst 0.832; 0.859 halving by
-    their gaps); sphere and torus: rings halving where
-    their gap is 0.707 row steps (worst 0.836, 0.830);
-    block_two_holes: its one near tie decided by the angle test (worst
-    0.847, 0.870 by the labels alone); cone_tip: an uneven fan of three
-    spokes round its apex, its ball's rings halving by design (worst 0.845;
-    0.862 where they halved wherever the gap fell below 0.8 row steps);
-    conebox: its cone's stuck ring
-    repair run again over a wider band, its top's stuck boundary layer
-    again with wider cells allowed (worst 0.865; 0.29% of the samples
-    violating without either); wedge: its ends' edge samples slide and its
-    sides' columns follow (worst 0.828; 1.20% violating with them fixed);
-    star_prism: the same, and the angle its caps' repair left at a reflex
-    corner split by a sample on its bisector (worst 0.850; 0.12% violating
-    without the split, 2.93% with its edge samples fixed); cutcube: its
-    scoop's rows h apart along the sphere and the scoop repaired on its
-    stereographic map, framed by the cube's faces across its rims (worst
-    0.863; 0.60% violating with the scan rows); fillet_box: its pieces'
-    lattices continued across the seams, its corner octants in latitude
-    rows repaired on their map (worst 0.841; 2.22% violating with the
-    scan rows)."""
+    III by the geodesic check, with issue 23's margin: every sample in a
+    DT_M triangle (none left out, as a cone's apex was when its cell's
+    corners fell between the truth's vertices) and every ratio at or below
+    0.85 (the condition wants below √3/2 ≈ 0.866; the margin keeps the
+    verdict from flipping between machines).  Worst ratios measured in stop
+    34: cube, L_sheet: plain lattices (0.707); box_hole and cylinder:
+    boundary layers and walls (0.832, 0.824); square_ring: annuli in rings,
+    walls as the lattice of their rims (0.805); pyramid: one lattice, the
+    ties across its lateral edges decided (0.830; 0.866 with the ties left,
+    2.09% violating with the scan rows at height 0.8); cone: a designed fan
+    of two spokes round the apex, rings halving by design (0.832; 0.859
+    halving by their gaps); sphere and torus: rings halving where their gap
+    is 0.707 row steps (0.836, 0.830; 0.864 and the torus's scan rows
+    1.000 before); block_two_holes: its one near tie decided by the angle
+    test (0.829); cone_tip: an uneven fan of three spokes round its apex,
+    its ball's rings halving by design (0.845; 0.862 where they halved
+    wherever the gap fell below 0.8 row steps); conebox: its cone's rings
+    halving by design, its top's boundary layer retried wider from a chart
+    ratio of 0.85 (0.843; 0.853 retried only from √3/2, 0.865 before the
+    cone's design); wedge: its ends' edge samples slide and its sides'
+    columns follow (0.825; 1.20% violating with them fixed); star_prism:
+    the same, and the angle its caps' repair left at a reflex corner split
+    by a sample on its bisector (0.829; 2.93% violating with its edge
+    samples fixed); cutcube: its scoop's rows h apart along the sphere and
+    the scoop repaired on its stereographic map, framed by the cube's faces
+    across its rims (0.846; 0.60% violating with the scan rows);
+    fillet_box: its pieces' lattices continued across the seams, its
+    corner octants in latitude rows repaired on their map (0.828; 2.22%
+    violating with the scan rows)."""
     rep = checked(name)
     assert rep.max_degree <= 33
-    assert np.all(rep.worst_ratio < np.sqrt(3) / 2)
+    assert np.isfinite(rep.worst_ratio).all()
+    assert rep.worst_ratio.max() <= 0.85
 
 
 @pytest.mark.slow
