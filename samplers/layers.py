@@ -1036,11 +1036,19 @@ def _end_columns(ang: np.ndarray, scale: float, t: float) -> np.ndarray:
 
 
 POLE_REACH = 10  # rings nearer a smooth pole than this (times t) are repaired
+#: ... tried in this order until the poles' repairs end below POLE_GOOD (in
+#: their maps); measured by the geodesic check: a ball at its defaults 10 ->
+#: 0.873, 8 -> 0.836, 11 -> 0.839, 9 -> 0.895, 12 -> 0.928; cone_tip 10 ->
+#: 0.845, 12 -> 0.849, 11 -> 0.864, 9 -> 0.949, 8 -> 0.979
+POLE_REACHES = (10, 8, 11, 12, 9)
+POLE_GOOD = 0.835
 APEX_SETTLED = 4.0  # round a cone tip's apex, a second repair keeps this near (times t) ...
 APEX_BROKEN = 0.85  # ... and mends the triangles from this ratio
 
 
-def _repair_pole(ring, columns, faces, t: float, end: int, memo: dict | None = None):
+def _repair_pole(
+    ring, columns, faces, t: float, end: int, memo: dict | None = None, reach: int = 0
+):
     """Repair the rings round a pole of a body of revolution: a sphere's
     smooth pole or a cone's apex.
 
@@ -1062,7 +1070,10 @@ def _repair_pole(ring, columns, faces, t: float, end: int, memo: dict | None = N
     axis make the cone's angle 0.1° short); one repair with that margin
     throughout moved the apex's samples too, and the tip's reconstruction
     then closed a triangle across the cone 1.5 t from the apex (two
-    components).  ``end`` 0 is the pole before the first ring, 1 the one
+    components).  ``reach`` (default ``POLE_REACH``) stands for
+    ``POLE_REACH`` throughout; the repair runs in units of the row step t,
+    so that its path does not hinge on the last bits of t.  ``end`` 0 is
+    the pole before the first ring, 1 the one
     after the last.  Returns the rings replaced, per new sample its
     (distance from the pole, angle) and ring (-1 for an added sample), and
     a report (for an apex with the second repair's ``margin_bad`` and
@@ -1077,13 +1088,17 @@ def _repair_pole(ring, columns, faces, t: float, end: int, memo: dict | None = N
     order = list(range(n)) if end == 0 else list(range(n - 1, -1, -1))
     face = faces[ring[order[0]][0]]
     kind = face.geomType()
-    if n <= POLE_REACH + 1:
+    reach = reach or POLE_REACH
+    if n <= reach + 1:
         return [], [], [], None
-    inner = order[: POLE_REACH - 1]  # rings 1 .. POLE_REACH - 1 steps from the pole
-    rim = order[POLE_REACH - 1]
+    inner = order[: reach - 1]  # rings 1 .. reach - 1 steps from the pole
+    rim = order[reach - 1]
     if kind not in ("SPHERE", "CONE") or any(ring[j][0] != ring[rim][0] for j in inner):
         return [], [], [], None  # the face ends before the rim: the map would cross faces
-    rho = [np.full(columns[j].size, (k + 1) * t) for k, j in enumerate(inner)]
+    # in units of the row step: the repair's path then does not hinge on the
+    # last bits of t (a turned ball's t differs from the upright one's in its
+    # last bit, and its poles' repair ended at 0.979 instead of 0.84)
+    rho = [np.full(columns[j].size, float(k + 1)) for k, j in enumerate(inner)]
     ang = [columns[j] for j in inner]
     row = [np.full(columns[j].size, j) for j in inner]
     sin_a, keep = 1.0, 0.5
@@ -1092,27 +1107,28 @@ def _repair_pole(ring, columns, faces, t: float, end: int, memo: dict | None = N
         fan = _apex_fan(2 * math.pi * sin_a)
         if fan is None:
             return [], [], [], None
-        rho[0], ang[0], row[0] = fan.ring(t, ang[0][0], inner[0])
+        rho[0], ang[0], row[0] = fan.ring(1.0, ang[0][0], inner[0])
         keep = FAN_KEEP
     rho_a, ang_a, row_a = np.concatenate(rho), np.concatenate(ang), np.concatenate(row)
     # repaired with each sample's own index for its row, so that a pole whose
     # rings equal another's bit for bit (a ball's two poles) takes its answer
-    key = (kind, sin_a, keep, rho_a.tobytes(), ang_a.tobytes(), columns[rim].tobytes())
+    key = (kind, sin_a, keep, reach, rho_a.tobytes(), ang_a.tobytes(), columns[rim].tobytes())
     if memo is not None and key in memo:
         r2, a2, own, bad, worst, margin = memo[key]
     else:
         own = np.arange(rho_a.size)
         r2, a2, own, bad, worst = _repair_developed(
-            rho_a, ang_a, own, columns[rim], POLE_REACH * t, sin_a, t, apex_keep=keep
+            rho_a, ang_a, own, columns[rim], float(reach), sin_a, 1.0, apex_keep=keep
         )
         margin = None
         if kind == "CONE":  # then the halvings farther out, with a margin
             r2, a2, own, *margin = _repair_developed(
-                r2, a2, own, columns[rim], POLE_REACH * t, sin_a, t, APEX_SETTLED, APEX_BROKEN
+                r2, a2, own, columns[rim], float(reach), sin_a, 1.0, APEX_SETTLED, APEX_BROKEN
             )
         if memo is not None:
             memo[key] = (r2, a2, own, bad, worst, margin)
     row2 = np.where(own >= 0, row_a[np.maximum(own, 0)], -1)
+    r2 = r2 * t
     report = {
         "kind": "pole" if kind == "SPHERE" else "apex",
         "face": int(ring[order[0]][0]),
@@ -1151,9 +1167,11 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     other one ending where the gap has shrunk to
     :data:`~sr33.samplers.rings.HALVING_GAP` row steps: those rings stand
     exactly there (:func:`sr33.samplers.rings.ring_positions`).  Within
-    ``POLE_REACH`` steps of a pole the rings are one step apart, end their
+    a reach of steps of a pole the rings are one step apart, end their
     crowded columns as on a cone (:func:`lattice_cone_faces`) and are
-    repaired (:func:`_repair_pole`).  Samples on the axis (the apex, the
+    repaired (:func:`_repair_pole`); the reach is the first of
+    ``POLE_REACHES`` whose repairs end below ``POLE_GOOD`` (else the best),
+    and the report says which (``pole_reach``).  Samples on the axis (the apex, the
     poles) stay; every other sample of the body is replaced (the seam's
     vertices are not features of the surface).  Each ring sample is the
     exact meridian point turned about the axis, so it lies on the surface.
@@ -1205,45 +1223,68 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     mer_s = np.concatenate([starts[k] + x for k, x in enumerate(seg)])
     mer_r = np.concatenate([q[3] for q in parts])
     m = halving_count(2 * math.pi * float(mer_r.max()) / h)
-    plan = ring_positions(
-        mer_s, mer_r, t, m, closed=closed, keep=(0, 0) if closed else (POLE_REACH, POLE_REACH)
-    )
-    if closed:  # round the torus from its widest point
-        w = float(mer_s[int(np.argmax(mer_r))])
-        ring = [at((w + x) % total) for x in plan.at]
-    else:
-        ring = [at(float(x)) for x in plan.at]
-    radial = np.array([r for _, _, r in ring])
-    widest = plan.widest
     ex = perpendicular(axis)
     ey = np.cross(axis, ex)
-    # the rings inside a pole's rim end their columns by the cone's rule (the
-    # rim itself, fixed in the pole's repair, only halves by design)
-    inner = POLE_REACH - 1
-    pole_zone = set() if closed else set(range(inner)) | set(range(len(ring) - inner, len(ring)))
-    columns = {widest: 2 * math.pi * np.arange(m) / m}
-    n_ring = len(ring)
-    for step in (-1, 1):
-        ang = columns[widest]
-        j = widest + step
-        # round a torus each way from the widest ring to the narrowest
-        while (0 <= j < n_ring) if not closed else (j - step) % n_ring != plan.meet:
-            jj = j % n_ring
-            if plan.halves[jj]:
-                ang = ang[::2]
-            elif jj in pole_zone:
-                ang = _end_columns(ang, radial[jj], t)
-            if not closed and (jj == 0 or jj == n_ring - 1) and ang.size > 5:
-                ang = ang[::2]  # the ring round a pole: at most 5 columns (see halving_count)
-            columns[jj] = ang
-            j += step
+    memo: dict = {}
+
+    def layout(reach: int):
+        """Rings, their columns and the poles' repairs with ``reach`` rows
+        round each pole; and the worst ratio the repairs were left with."""
+        plan = ring_positions(
+            mer_s, mer_r, t, m, closed=closed, keep=(0, 0) if closed else (reach, reach)
+        )
+        if closed:  # round the torus from its widest point
+            w = float(mer_s[int(np.argmax(mer_r))])
+            ring = [at((w + x) % total) for x in plan.at]
+        else:
+            ring = [at(float(x)) for x in plan.at]
+        radial = np.array([r for _, _, r in ring])
+        widest = plan.widest
+        # the rings inside a pole's rim end their columns by the cone's rule
+        # (the rim itself, fixed in the pole's repair, only halves by design)
+        inner = reach - 1
+        n_ring = len(ring)
+        pole_zone = set() if closed else set(range(inner)) | set(range(n_ring - inner, n_ring))
+        columns = {widest: 2 * math.pi * np.arange(m) / m}
+        for step in (-1, 1):
+            ang = columns[widest]
+            j = widest + step
+            # round a torus each way from the widest ring to the narrowest
+            while (0 <= j < n_ring) if not closed else (j - step) % n_ring != plan.meet:
+                jj = j % n_ring
+                if plan.halves[jj]:
+                    ang = ang[::2]
+                elif jj in pole_zone:
+                    ang = _end_columns(ang, radial[jj], t)
+                if not closed and (jj == 0 or jj == n_ring - 1) and ang.size > 5:
+                    ang = ang[::2]  # the ring round a pole: at most 5 columns (halving_count)
+                columns[jj] = ang
+                j += step
+        repaired = [
+            (end, _repair_pole(ring, columns, faces, t, end, memo, reach))
+            for end in (() if closed else (0, 1))
+        ]
+        # what each repair was left with (an apex: after its second repair)
+        left = [
+            rep.get("margin_worst", rep["worst"])
+            for _, (_, _, _, rep) in repaired
+            if rep is not None
+        ]
+        return ring, columns, repaired, max(left, default=0.0)
+
+    # the poles' repairs are a local search whose end depends on its input:
+    # the first reach whose repairs end below POLE_GOOD, else the best
+    tried = []
+    for reach in POLE_REACHES if not closed else (POLE_REACH,):
+        tried.append((reach, *layout(reach)))
+        if tried[-1][-1] < POLE_GOOD:
+            break
+    reach, ring, columns, repaired, _ = min(tried, key=lambda x: round(x[-1], 6))
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     pts, ids, fids = [], [], []
     poles: list[int] = []
     reports: list[dict] = []
-    memo: dict = {}
-    for end in () if closed else (0, 1):
-        pole_rows, p_ang, p_row, report = _repair_pole(ring, columns, faces, t, end, memo)
+    for end, (pole_rows, p_ang, p_row, report) in repaired:
         if report is None:
             continue
         poles += pole_rows
@@ -1270,5 +1311,11 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         np.zeros(new.shape[0], dtype=bool),
     )
     return [
-        {"kind": "revolved rings", "rows": len(ring), "columns": m, "samples": len(new)}
+        {
+            "kind": "revolved rings",
+            "rows": len(ring),
+            "columns": m,
+            "samples": len(new),
+            "pole_reach": reach,
+        }
     ] + reports
