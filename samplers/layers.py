@@ -665,6 +665,18 @@ def _corner_points(face, to2d) -> np.ndarray:
     return to2d(np.array(pts)) if pts else np.empty((0, 2))
 
 
+def _first_passing(options, make, passes, rank=lambda _: 0):
+    """``(option, make(option))`` for the first option whose result passes,
+    trying them in order; else the one whose result ranks lowest (the first
+    of equal ones)."""
+    tried = []
+    for option in options:
+        tried.append((option, make(option)))
+        if passes(tried[-1][1]):
+            return tried[-1]
+    return min(tried, key=lambda x: rank(x[1]))
+
+
 def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     """Lay every full cone with a sampled rim out in rings that keep their columns.
 
@@ -731,14 +743,11 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         # APEX_REACH rows, then one to two fewer, then more, that no halving
         # has to be moved off its gap
         meridian = (np.array([0.0, slant]), np.array([slant * sin_a, 0.0]))
-        plans = [
-            ring_positions(*meridian, t, rim_ang.size, keep=(1, k))
-            for k in (APEX_REACH, APEX_REACH - 1, APEX_REACH - 2, APEX_REACH + 1)
-        ]
-        reach, plan = next(
-            ((k, p) for k, p in zip((0, 1, 2, 3), plans) if p.moved == 0), (0, plans[0])
+        reach, plan = _first_passing(
+            (APEX_REACH, APEX_REACH - 1, APEX_REACH - 2, APEX_REACH + 1),
+            lambda k, mer=meridian, t=t, m=rim_ang.size: ring_positions(*mer, t, m, keep=(1, k)),
+            lambda p: p.moved == 0,
         )
-        reach = (APEX_REACH, APEX_REACH - 1, APEX_REACH - 2, APEX_REACH + 1)[reach]
         designed = plan.at.size - (reach - 1) if plan.halves.any() else 0
         for j, at_j in enumerate(plan.at, start=1):
             rho = slant - at_j
@@ -1070,10 +1079,10 @@ def _repair_pole(
     axis make the cone's angle 0.1° short); one repair with that margin
     throughout moved the apex's samples too, and the tip's reconstruction
     then closed a triangle across the cone 1.5 t from the apex (two
-    components).  ``reach`` (default ``POLE_REACH``) stands for
-    ``POLE_REACH`` throughout; the repair runs in units of the row step t,
-    so that its path does not hinge on the last bits of t.  ``end`` 0 is
-    the pole before the first ring, 1 the one
+    components).  ``reach`` (default ``POLE_REACH``) is the number of rows
+    round the pole; the repair runs in units of the row step t, so that its
+    path does not hinge on the last bits of t.  ``end`` 0 is the pole
+    before the first ring, 1 the one
     after the last.  Returns the rings replaced, per new sample its
     (distance from the pole, angle) and ring (-1 for an added sample), and
     a report (for an apex with the second repair's ``margin_bad`` and
@@ -1233,11 +1242,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         plan = ring_positions(
             mer_s, mer_r, t, m, closed=closed, keep=(0, 0) if closed else (reach, reach)
         )
-        if closed:  # round the torus from its widest point
-            w = float(mer_s[int(np.argmax(mer_r))])
-            ring = [at((w + x) % total) for x in plan.at]
-        else:
-            ring = [at(float(x)) for x in plan.at]
+        ring = [at((plan.origin + x) % total if closed else float(x)) for x in plan.at]
         radial = np.array([r for _, _, r in ring])
         widest = plan.widest
         # the rings inside a pole's rim end their columns by the cone's rule
@@ -1246,20 +1251,15 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         n_ring = len(ring)
         pole_zone = set() if closed else set(range(inner)) | set(range(n_ring - inner, n_ring))
         columns = {widest: 2 * math.pi * np.arange(m) / m}
-        for step in (-1, 1):
-            ang = columns[widest]
-            j = widest + step
-            # round a torus each way from the widest ring to the narrowest
-            while (0 <= j < n_ring) if not closed else (j - step) % n_ring != plan.meet:
-                jj = j % n_ring
-                if plan.halves[jj]:
-                    ang = ang[::2]
-                elif jj in pole_zone:
-                    ang = _end_columns(ang, radial[jj], t)
-                if not closed and (jj == 0 or jj == n_ring - 1) and ang.size > 5:
-                    ang = ang[::2]  # the ring round a pole: at most 5 columns (halving_count)
-                columns[jj] = ang
-                j += step
+        for j, prev in plan.walk():
+            ang = columns[prev]
+            if plan.halves[j]:
+                ang = ang[::2]
+            elif j in pole_zone:
+                ang = _end_columns(ang, radial[j], t)
+            if not closed and (j == 0 or j == n_ring - 1) and ang.size > 5:
+                ang = ang[::2]  # the ring round a pole: at most 5 columns (halving_count)
+            columns[j] = ang
         repaired = [
             (end, _repair_pole(ring, columns, faces, t, end, memo, reach))
             for end in (() if closed else (0, 1))
@@ -1274,12 +1274,12 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
 
     # the poles' repairs are a local search whose end depends on its input:
     # the first reach whose repairs end below POLE_GOOD, else the best
-    tried = []
-    for reach in POLE_REACHES if not closed else (POLE_REACH,):
-        tried.append((reach, *layout(reach)))
-        if tried[-1][-1] < POLE_GOOD:
-            break
-    reach, ring, columns, repaired, _ = min(tried, key=lambda x: round(x[-1], 6))
+    reach, (ring, columns, repaired, _) = _first_passing(
+        POLE_REACHES if not closed else (POLE_REACH,),
+        layout,
+        lambda x: x[-1] < POLE_GOOD,
+        lambda x: round(x[-1], 6),
+    )
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     pts, ids, fids = [], [], []
     poles: list[int] = []

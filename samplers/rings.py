@@ -2,20 +2,20 @@
 where their columns halve.
 
 A body of revolution is laid out in rings (parallels, one row each) whose
-columns continue from ring to ring (:func:`sr33.samplers.layers.lattice_revolved_body`):
-the cells are rectangles, gap by row step, whose Delaunay triangles meet
-Condition III-ii while the gap stays within 0.62 to 1.61 row steps.  As
-the rings shrink towards the axis, every other column ends; the triangles
-where a ring halves, and the rectangles after it, meet the condition only
-when the gap at the halving is close to ``HALVING_GAP`` row steps (flat
-estimate: the halving triangle's ratio ``sqrt(x^2 + 1) / 2x`` falls with
-the gap x, the merged cells' ``2x / sqrt(4x^2 + 1)`` rises with it; they
-balance at x = 0.751, both 0.832).  Rings one row step apart hit that gap
-only by chance (on a ball of radius 20 h, a ring's radius changes by up
-to 7 % a step at mid-latitude, the window for a ratio of 0.845 is ±2 %),
-so :func:`ring_positions` puts a ring exactly where the gap reaches it, one
-row step from its neighbours, and evens the rest of the way out over the
-steps between halvings.
+columns continue from ring to ring (:func:`sr33.samplers.layers.lattice_revolved_body`,
+:func:`sr33.samplers.layers.lattice_cone_faces`): the cells are rectangles,
+gap by row step, whose Delaunay triangles meet Condition III-ii while the
+gap stays within 0.62 to 1.61 row steps.  As the rings shrink towards the
+axis, every other column ends.  With a gap x (in row steps) where a ring
+halves, the rectangles before it have the ratio ``1 / sqrt(1 + x^2)`` and
+the merged ones after it ``2x / sqrt(4x^2 + 1)``: they balance at x = 0.707
+(both 0.816), where the triangle joining a dropped column to the two kept
+ones has ``sqrt(x^2 + t1^2) / 2x``, 0.76 with a step t1 = 0.8 across the
+halving.  Rings one row step apart hit that gap only by chance (on a ball
+of radius 20 h a ring's radius changes by up to 7 % a step), so
+:func:`ring_positions` puts the halving ring exactly where the gap reaches
+it, with the steps ``HALVING_STEPS`` round it, and evens the rest of the
+way out over the steps between halvings (measured: docs/sampler.md).
 
 Plain numpy; the meridian is given as arc lengths and radii.
 """
@@ -29,9 +29,8 @@ import numpy as np
 
 #: a ring's columns halve where their gap is this many row steps
 HALVING_GAP = 0.707
-#: the steps before and after a halving ring, times the row step: nearer on
-#: the side of the full columns and farther on the side of the merged ones,
-#: both ratios fall (flat estimate at the gap 0.751: 0.780 and 0.807)
+#: the steps before and after a halving ring, times the row step: the
+#: shorter step across the halving brings its triangle from 0.87 to 0.76
 HALVING_STEPS = (0.8, 1.0)
 
 
@@ -55,6 +54,9 @@ class RingPlan:
     moved : int
         Halvings due within two steps of a kept end's first ring, put two
         steps before it (at a gap wider than the design's).
+    origin : float
+        Arc length of the meridian where ``at`` starts (a closed meridian's
+        widest point; 0 on an open one).
     """
 
     at: np.ndarray
@@ -62,6 +64,21 @@ class RingPlan:
     widest: int
     meet: int = -1
     moved: int = 0
+    origin: float = 0.0
+
+    def walk(self) -> list[tuple[int, int]]:
+        """(ring, the ring it takes its columns from), from the widest ring
+        each way: to the ends of an open meridian, to the narrowest ring
+        (``meet``) round a closed one, which both ways reach (the second
+        way's columns stand there)."""
+        n = self.at.size
+        out = []
+        for step in (-1, 1):
+            j = self.widest + step
+            while (0 <= j < n) if self.meet < 0 else (j - step) % n != self.meet:
+                out.append((j % n, (j - step) % n))
+                j += step
+        return out
 
 
 def _crossing(s: np.ndarray, rho: np.ndarray, a: float, b: float, level: float) -> float | None:
@@ -177,7 +194,7 @@ def ring_positions(
     length = float(s[-1])
     if closed:
         # unrolled so that the widest point is at 0, one turn either way
-        w = float(s[int(np.argmax(rho[:-1]))])
+        w = float(s[int(np.argmax(rho[:-1]))])  # the widest point
         ss = np.r_[s[:-1] - w - length, s[:-1] - w, s[:-1] - w + length]
         rr = np.r_[rho[:-1], rho[:-1], rho[:-1]]
         order = np.argsort(ss, kind="stable")
@@ -192,7 +209,7 @@ def ring_positions(
                 at[p + length] = halves
         pos = np.array(sorted(at))
         meet = int(np.argmin(np.abs(pos - narrow)))
-        return RingPlan(pos, np.array([at[p] for p in sorted(at)]), 0, meet)
+        return RingPlan(pos, np.array([at[p] for p in sorted(at)]), 0, meet, origin=w)
     rows = round(length / step)
     uniform = np.arange(1, rows) * step
     lo, hi = keep[0] - 1, rows - 1 - keep[1]  # the designed rings' first and last index

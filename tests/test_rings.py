@@ -16,15 +16,10 @@ def _torus_meridian(major, minor, count=20001):
 
 
 def _columns(plan, m):
-    """Columns per ring walking from the widest ring each way (to the meeting ring)."""
-    n = plan.at.size
+    """Column counts per ring, walked from the widest ring (RingPlan.walk)."""
     cols = {plan.widest: m}
-    for step in (-1, 1):
-        c, j = m, plan.widest + step
-        while (0 <= j < n) if plan.meet < 0 else (j - step) % n != plan.meet:
-            c = c // 2 if plan.halves[j % n] else c
-            cols[j % n] = c
-            j += step
+    for j, prev in plan.walk():
+        cols[j] = cols[prev] // 2 if plan.halves[j] else cols[prev]
     return cols
 
 

@@ -740,43 +740,36 @@ def test_partial_spheres_with_sharp_rims_are_repaired(sampled):
     assert not [x for x in r.meta["repairs"] if x["kind"] == "sphere"]
 
 
-def test_a_turned_torus_keeps_its_rings_and_its_margin():
-    """The rings follow the torus's own axis, not the scan directions: turned
-    by (37°, -112°, 71°) the same number of samples, every one on the
-    surface, and the geodesic check's worst ratio at 0.85 or below."""
+@pytest.mark.parametrize(
+    "name, turn",
+    [
+        pytest.param("torus", (37.0, -112.0, 71.0)),
+        pytest.param("sphere", (-111.0, 48.0, 152.0), marks=pytest.mark.slow),
+        pytest.param("cone_tip", (-111.0, 48.0, 152.0), marks=pytest.mark.slow),
+    ],
+)
+def test_a_turned_body_of_revolution_gets_the_upright_answer(sampled, checked, name, turn):
+    """The rings follow the body's own axis, not the scan directions, and the
+    poles' repairs run in units of the row step, so the last bits of the
+    step (a turned model's meridian measures its length a bit apart) do not
+    decide their path: turned, the torus, the ball and the cone tip get the
+    upright sampling's count, every sample on the surface, and its worst
+    ratio, at 0.85 or below (the turned ball's poles once ended at 0.975
+    where the upright's ended at 0.836)."""
     pytest.importorskip("potpourri3d")
     from sr33.validators.conditions import sample_conditions
     from sr33.validators.fidelity import distance_to_surface
 
-    upright = scan(shapes.build("torus"))
-    s = shapes.build("torus", rotate_x=37.0, rotate_y=-112.0, rotate_z=71.0)
+    _, upright = sampled[name]
+    s = shapes.build(name, rotate_x=turn[0], rotate_y=turn[1], rotate_z=turn[2])
     r = scan(s)
     assert r.points.shape == upright.points.shape
     d = distance_to_surface(r.points, s.truth_vertices, s.truth_triangles)
     assert d.max() < 0.05 * r.meta["spacing"]  # up to the truth's sagitta
     rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
     assert rep.max_degree <= 33 and np.nanmax(rep.worst_ratio) <= 0.85
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("name", ["sphere", "cone_tip"])
-def test_a_turned_body_of_revolution_gets_the_upright_answer(sampled, checked, name):
-    """The poles' repairs run in units of the row step, so the last bits of
-    the step (a turned model's meridian measures its length a bit apart)
-    do not decide their path: turned, the ball and the cone tip get the
-    upright sampling's count and worst ratio (the turned ball's poles once
-    ended at 0.975 where the upright's ended at 0.836)."""
-    pytest.importorskip("potpourri3d")
-    from sr33.validators.conditions import sample_conditions
-
-    _, upright = sampled[name]
-    s = shapes.build(name, rotate_x=-111.0, rotate_y=48.0, rotate_z=152.0)
-    r = scan(s)
-    assert r.points.shape == upright.points.shape
-    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
-    assert rep.max_degree <= 33 and np.nanmax(rep.worst_ratio) <= 0.85
     # the same layout, judged on the turned truth's own tessellation (0.841
-    # for the ball at this turn, 0.836 upright; 0.975 before)
+    # for the ball at its turn, 0.836 upright; 0.975 before)
     np.testing.assert_allclose(
         np.nanmax(rep.worst_ratio), np.nanmax(checked(name).worst_ratio), atol=0.01
     )
