@@ -53,6 +53,17 @@ def surface_distance(solid, points: np.ndarray) -> np.ndarray:
     return out
 
 
+def timed_runs(repeat: int, fn, *args, **kwargs):
+    """``fn(*args, **kwargs)`` run ``repeat`` times: (median seconds, every
+    run's seconds, the last result; NaN, [], None for no run)."""
+    runs, out = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn(*args, **kwargs)
+        runs.append(time.perf_counter() - t0)
+    return (float(np.median(runs)) if runs else float("nan")), runs, out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(ROOT / "out" / "samplers.json"))
@@ -83,18 +94,10 @@ def main(argv=None) -> int:
         t0 = time.perf_counter()
         s = shapes.build(name)
         tb = time.perf_counter() - t0
-        times = []
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            r = scan(s)
-            times.append(time.perf_counter() - t0)
-        ts = float(np.median(times))
-        large_times = []
-        for _ in range(repeat if args.large else 0):
-            t0 = time.perf_counter()
-            big = scan(s, target_points=args.large)
-            large_times.append(time.perf_counter() - t0)
-        tl = float(np.median(large_times)) if large_times else float("nan")
+        ts, times, r = timed_runs(repeat, scan, s)
+        tl, large_times, big = timed_runs(
+            repeat if args.large else 0, scan, s, target_points=args.large
+        )
         p, h = r.points, r.meta["spacing"]
         d, _ = cKDTree(p).query(p, 2)
         nn = d[:, 1] / h
@@ -111,12 +114,9 @@ def main(argv=None) -> int:
             ]
         )
         on = float(surface_distance(s.solid, pick).max() / s.size)
-        check_times = []
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            cond = sample_conditions(p, s.truth_vertices, s.truth_triangles)
-            check_times.append(time.perf_counter() - t0)
-        tc = float(np.median(check_times))
+        tc, check_times, cond = timed_runs(
+            repeat, sample_conditions, p, s.truth_vertices, s.truth_triangles
+        )
         violating = int(np.count_nonzero(~(cond.worst_ratio < np.sqrt(3) / 2)))
         rec = reconstruct(p, 33)
         st = mesh_stats(rec.triangles, rec.vertices.shape[0])
@@ -135,7 +135,7 @@ def main(argv=None) -> int:
             "conditions_s": tc,
             "conditions_runs_s": check_times,
             "sample_runs_s": times,
-            "large_points": int(big.points.shape[0]) if large_times else 0,
+            "large_points": int(big.points.shape[0]) if big is not None else 0,
             "large_sample_s": tl,
             "large_sample_runs_s": large_times,
             "repairs": r.meta.get("repairs", []),
