@@ -255,11 +255,21 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
     cache: dict[tuple, _Layout] = {}
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     for rf in round_faces(adjacency, tol):
+        # the layout is made in units of h from the radii rounded there, so
+        # that its repair does not hinge on the radii's last bits (a cone
+        # turned off the axes: its disk's repair took another path and ended
+        # at 0.872 where the upright's ended at 0.82); the rims are then put
+        # back on their circles
         key = tuple(round(r / h, 9) for r in rf.radii)
         if key not in cache:
-            cache[key] = _layout(rf.radii, h)
+            cache[key] = _layout(key, 1.0)
         lay = cache[key]
-        uv, rim, ring = lay.uv, lay.rim, lay.ring
+        uv, rim, ring = lay.uv * h, lay.rim, lay.ring
+        last = int(ring.max())
+        for j, r in ((0, rf.radii[0]), (last, rf.radii[-1] if len(rf.radii) > 1 else None)):
+            on = ring == j
+            if r is not None and on.any():
+                uv[on] *= r / np.linalg.norm(uv[on], axis=1)[:, None]
         ex = perpendicular(rf.normal)
         ey = np.cross(rf.normal, ex)
         q = s.points - rf.centre

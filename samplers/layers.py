@@ -342,7 +342,14 @@ def _congruence(x, h: float) -> bytes:
 
 
 def repair_planar_faces(
-    occ, s: Samples, h: float, size: float, row_dirs=None, skip=frozenset(), again: bool = True
+    occ,
+    s: Samples,
+    h: float,
+    size: float,
+    row_dirs=None,
+    skip=frozenset(),
+    again: bool = True,
+    walls: dict[int, np.ndarray] | None = None,
 ) -> list[dict]:
     """Repair the boundary layer of every planar face bounded by circular arcs
     or by straight sharp edges slanted to its scan rows.
@@ -388,7 +395,9 @@ def repair_planar_faces(
     """
     reports = []
     done: dict[tuple, object] = {}
-    walls: dict[int, np.ndarray] = {}  # a full cylinder's first rim laid: its samples (3-D)
+    # a full cylinder's first rim laid: its samples (3-D); a face repaired
+    # again gets the rims laid in the first round
+    walls = {} if walls is None else walls
     shifts: dict[int, list] = {}  # per face whose columns follow an edge: the edge's shifts
     outlines: dict[tuple, tuple] = {}  # a face bounded by straight edges: its samples, answer
     tol = 1e-7 * size
@@ -537,17 +546,18 @@ def repair_planar_faces(
             shifts.setdefault(ln.other, []).append(
                 (a3, u3, np.r_[0.0, s0[order], length], np.r_[0.0, (s1 - s0)[order], 0.0])
             )
-        rim = moved & s.on_feature[np.maximum(src, 0)]
         reports.append(s.put(idx, r, pts3, fi, "plane"))
         for a in arcs:
             if a.wall >= 0 and a.wall not in walls:
-                walls[a.wall] = pts3[rim & (a.distance(r.uv) < tol)]
+                # every sample on the rim, kept or added by the repair
+                walls[a.wall] = pts3[a.distance(r.uv) < tol]
     _follow_columns(s, shifts, faces, tol)
     stuck = {x["face"] for x in reports if x["worst"] >= STUCK and x["bad"] <= FEW_BAD}
     if again and stuck:
         rest = set(range(len(faces))) - stuck
         redone = {
-            x["face"]: x for x in repair_planar_faces(occ, s, h, size, row_dirs, rest, again=False)
+            x["face"]: x
+            for x in repair_planar_faces(occ, s, h, size, row_dirs, rest, again=False, walls=walls)
         }
         reports = [redone.get(x["face"], x) for x in reports]
     return reports
@@ -635,8 +645,10 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
         mine = (np.abs(radial - radius) < tol) & (axial > vmin - tol) & (axial < vmax + tol)
         idx = np.flatnonzero(mine)
         ang = np.arctan2(dot(q[idx], ey), dot(q[idx], ex)) % (2 * math.pi)
-        rim_lo = s.on_feature[idx] & (np.abs(axial[idx] - vmin) < tol)
-        rim_hi = s.on_feature[idx] & (np.abs(axial[idx] - vmax) < tol)
+        # the rims' samples by position (a planar face's repair may have
+        # added one on a rim: it is on the sharp edge all the same)
+        rim_lo = np.abs(axial[idx] - vmin) < tol
+        rim_hi = np.abs(axial[idx] - vmax) < tol
         a_lo, a_hi = np.sort(ang[rim_lo]), np.sort(ang[rim_hi])
         if a_lo.size < 3 or a_lo.size != a_hi.size or np.abs(a_lo - a_hi).max() > 1e-9:
             continue
