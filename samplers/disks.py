@@ -245,8 +245,12 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
 
     Replaces the face's samples (its rims' included) by the rings of
     :func:`ring_plan`, repaired where a ring halves and round a disk's
-    centre.  Faces of equal radii get one layout (a cylinder's two caps).
-    Returns one report per face and the indices of the faces laid out.
+    centre.  The layout is made in units of h from the radii rounded on a
+    1e-9 h grid (a model turned off the axes, whose radii differ in their
+    last bits, gets the upright's layout; the rims are then put back on
+    their circles), so faces of equal radii get one layout (a cylinder's two
+    caps).  Returns one report per face and the indices of the faces laid
+    out.
     """
     tol = 1e-7 * size
     adjacency = EdgeFaces(occ)

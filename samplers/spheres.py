@@ -187,7 +187,10 @@ def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=N
     """Repair one partial sphere on its stereographic map (see
     :func:`repair_sphere_faces`): the samples of ``fixed`` (default: the
     feature samples) stay, the face's other samples are free, the
-    neighbours' samples near its rims are the judged frame.  Returns the
+    neighbours' samples near its rims are the judged frame; a repair ending
+    at or above ``MAP_GOOD`` on the map runs again with wider cells, then
+    with its corners split where few triangles are bad, and the lowest
+    worst ratio is kept.  Returns the
     face's report, or None where the face is not repaired (it wraps more
     than about 78° from its centre, a rim is no circle on the map, or no
     sample is free)."""
