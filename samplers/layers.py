@@ -96,17 +96,34 @@ def _arcs(face, to2d, across=()) -> list[Arc]:
 
 def _nearest_curve(arcs: list, p: np.ndarray) -> np.ndarray:
     """Index of the curve (arc or line) nearest to each point."""
-    return np.argmin(np.stack([a.distance(p) for a in arcs], axis=1), axis=1)
+    return np.argmin(_distances(arcs, p), axis=1)
 
 
 def _project_onto(curves: list, margin: float):
     """Map each point to the nearest point of its nearest curve (arcs and
     lines), at least ``margin`` from the curve's ends."""
 
+    lines = [k for k, c in enumerate(curves) if isinstance(c, _Line)]
+    edges = _Edges([curves[k] for k in lines])
+    column = np.full(len(curves), -1)
+    column[lines] = np.arange(len(lines))
+    # a line's ends are kept ``margin`` away: its parameter within [m, 1 - m]
+    m = np.array([margin / float(norm(curves[k].b - curves[k].a)) for k in lines])
+
     def project(p: np.ndarray) -> np.ndarray:
         which = _nearest_curve(curves, p)
         out = p.copy()
+        # the lines at once (the same operations as _Line.project, point by point)
+        on = column[which]
+        sel = np.flatnonzero(on >= 0)
+        if sel.size:
+            k = on[sel]
+            t = dot(p[sel] - edges.a[k], edges.d[k]) / edges.dd[k]
+            t = np.clip(t, m[k], 1.0 - m[k])
+            out[sel] = edges.a[k] + t[:, None] * edges.d[k]
         for k, a in enumerate(curves):
+            if column[k] >= 0:
+                continue
             sel = which == k
             if sel.any():
                 out[sel] = a.project(p[sel], margin)
@@ -149,11 +166,13 @@ def _line_ghosts(lines: list[_Line], h: float):
     corners = np.vstack(
         [end - j * h * ln.inward for ln in lines for end in (ln.a, ln.b) for j in (1.0, 2.0)]
     )
+    edges = _Edges(lines)
 
     def ghosts(p: np.ndarray) -> np.ndarray:
         out = [corners]
-        for ln in lines:
-            q = p[ln.distance(p) < 1e-6 * h]
+        on = edges.distance(p) < 1e-6 * h
+        for k, ln in enumerate(lines):
+            q = p[on[:, k]]
             out += [q - j * h * ln.inward for j in (1.0, 2.0)]
         return np.vstack(out)
 
@@ -209,6 +228,39 @@ class _Line:
         m = margin / float(norm(d))
         t = np.clip(self.along(p), m, 1.0 - m)
         return self.a + t[:, None] * d
+
+
+class _Edges:
+    """Several :class:`_Line`'s ``along`` and ``distance`` at once, with the
+    same operations element by element (the same bits as one line at a
+    time): the repair calls them at every step, for every slanted edge."""
+
+    def __init__(self, lines: list[_Line]):
+        self.a = np.array([ln.a for ln in lines], dtype=np.float64).reshape(-1, 2)
+        self.d = np.array([ln.b - ln.a for ln in lines], dtype=np.float64).reshape(-1, 2)
+        self.dd = dot(self.d, self.d)
+
+    def along(self, p: np.ndarray) -> np.ndarray:
+        """(n, m): every point's foot parameter on every edge."""
+        return dot(p[:, None, :] - self.a[None], self.d[None]) / self.dd[None]
+
+    def distance(self, p: np.ndarray) -> np.ndarray:
+        """(n, m): every point's distance to every edge."""
+        t = np.clip(self.along(p), 0.0, 1.0)
+        q = p[:, None, :] - (self.a[None] + t[:, :, None] * self.d[None])
+        return np.sqrt((q * q).sum(axis=-1))
+
+
+def _distances(curves: list, p: np.ndarray) -> np.ndarray:
+    """(n, m): every point's distance to every curve (arcs and lines, in order)."""
+    out = np.empty((p.shape[0], len(curves)))
+    lines = [k for k, c in enumerate(curves) if isinstance(c, _Line)]
+    if lines:
+        out[:, lines] = _Edges([curves[k] for k in lines]).distance(p)
+    for k, c in enumerate(curves):
+        if not isinstance(c, _Line):
+            out[:, k] = c.distance(p)
+    return out
 
 
 def _slanted(face, row_dir, u: np.ndarray) -> bool:
@@ -314,14 +366,22 @@ def _chain(fns):
 def _clamp_lines(lines: list[_Line], h: float):
     """Keep free samples at least 0.4 h inside every slanted edge."""
 
+    edges = _Edges(lines)
+    normals = np.array([ln.inward for ln in lines], dtype=np.float64).reshape(-1, 2)
+
+    def measure(q: np.ndarray):
+        return edges.along(q), dot(q[:, None, :] - edges.a[None], normals[None])
+
     def clamp(p: np.ndarray) -> np.ndarray:
+        # edge by edge, each seeing the points the ones before it moved
         out = p.copy()
-        for ln in lines:
-            t = ln.along(out)
-            inward = dot(out - ln.a, ln.inward)
+        t_all, in_all = measure(out)
+        for k, ln in enumerate(lines):
+            t, inward = t_all[:, k], in_all[:, k]
             bad = (t > 0) & (t < 1) & (inward < 0.4 * h) & (inward > -2 * h)
             if bad.any():
                 out[bad] += (0.4 * h - inward[bad])[:, None] * ln.inward
+                t_all[bad], in_all[bad] = measure(out[bad])
         return out
 
     return clamp

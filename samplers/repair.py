@@ -252,6 +252,14 @@ def _triangles(prob: _Problem, subset=None):
     return pts, of, turned, tri[keep]
 
 
+def _summed(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """(n, 2): ``values`` added up per ``index``, one after another in their
+    order from zero (what ``np.add.at`` on zeros gives, bit for bit)."""
+    return np.stack(
+        [np.bincount(index, weights=values[:, j], minlength=n) for j in range(2)], axis=1
+    )
+
+
 def _energy(prob: _Problem, subset=None, active=None):
     """Energy, its gradient on the samples, the ratios, the triangles (as
     sample ids) and their corners' positions."""
@@ -284,14 +292,17 @@ def _energy(prob: _Problem, subset=None, active=None):
     rho = l2 / l3
     over = np.maximum(0.0, rho - TARGET)
     energy = float((over**2).sum())
-    gp = np.zeros_like(pts)
+    # the gradient's terms, summed per point at the end in this order (one
+    # bincount: the same sequence of additions as np.add.at term by term)
+    at: list[np.ndarray] = []
+    terms: list[np.ndarray] = []
 
     def push(edge_col, coef):
         a = tri[rows, _EDGES[edge_col, 0]]
         b = tri[rows, _EDGES[edge_col, 1]]
         unit = vec[rows, edge_col] / length[rows, edge_col][:, None]
-        np.add.at(gp, a, coef[:, None] * unit)
-        np.add.at(gp, b, -coef[:, None] * unit)
+        at.extend((a, b))
+        terms.extend((coef[:, None] * unit, -coef[:, None] * unit))
 
     push(i2, 2 * over / l3)
     push(i3, -2 * over * l2 / l3**2)
@@ -335,11 +346,13 @@ def _energy(prob: _Problem, subset=None, active=None):
         * (p - cen[:, None, :])
         / np.maximum(radius, 1e-300)[:, None, None]
     )
-    np.add.at(gp, tri.ravel(), pull.reshape(-1, 2))
+    at.append(tri.ravel())
+    terms.append(pull.reshape(-1, 2))
+    gp = _summed(np.concatenate(at), np.concatenate(terms), pts.shape[0])
     real = of >= 0
     if prob.turn is not None:  # an image's gradient, turned back onto its sample
         gp = rotate(gp, -turned)
-    np.add.at(grad, of[real], gp[real])
+    grad = _summed(of[real], gp[real], grad.shape[0])
     grad[~(prob.free | prob.slide)] = 0.0
     return energy, grad, rho, of[tri], p
 

@@ -307,3 +307,37 @@ def test_a_stuck_repair_is_retried_and_never_ends_worse(monkeypatch):
     assert rank(retried) <= rank(single)
     again = repair(uv, free, h, **kw)
     np.testing.assert_array_equal(again.uv, retried.uv)
+
+
+def test_the_repairs_vectorised_sums_and_edges_keep_the_bits():
+    """The repair's per-step geometry is computed for all slanted edges at
+    once and its gradient summed with one bincount; both must give the bits
+    of the one-at-a-time code they replaced (np.add.at term by term, each
+    edge's own ``along``/``distance``/``project``), or a sampling would move."""
+    from sr33.samplers import layers
+    from sr33.samplers import repair as rp
+
+    rng = np.random.default_rng(3)
+    index = rng.integers(0, 40, 500)
+    values = rng.normal(size=(500, 2)) * 10.0 ** rng.integers(-8, 3, (500, 1))
+    expected = np.zeros((40, 2))
+    for part in np.array_split(np.arange(500), 7):  # several add.at calls in a row
+        np.add.at(expected, index[part], values[part])
+    assert rp._summed(index, values, 40).tobytes() == expected.tobytes()
+
+    def line(a, b):
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        d = (b - a) / np.linalg.norm(b - a)
+        return layers._Line(a, b, np.array([-d[1], d[0]]), np.empty((0, 2)), True)
+
+    lines = [line(rng.normal(size=2), rng.normal(size=2)) for _ in range(6)]
+    p = rng.normal(size=(300, 2)) * 1.7
+    edges = layers._Edges(lines)
+    for k, ln in enumerate(lines):
+        assert edges.along(p)[:, k].tobytes() == ln.along(p).tobytes()
+        assert edges.distance(p)[:, k].tobytes() == ln.distance(p).tobytes()
+    which = np.argmin(np.stack([ln.distance(p) for ln in lines], axis=1), axis=1)
+    one_by_one = p.copy()
+    for k, ln in enumerate(lines):
+        one_by_one[which == k] = ln.project(p[which == k], 0.05)
+    assert layers._project_onto(lines, 0.05)(p).tobytes() == one_by_one.tobytes()
