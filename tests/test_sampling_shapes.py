@@ -823,3 +823,32 @@ def test_turned_rims_disks_and_scoops_meet_condition_iii(sampled, name):
     if name == "cutcube":
         _, upright = sampled[name]
         assert _reports(r, "cylinder lattice") == _reports(upright, "cylinder lattice")
+
+
+@pytest.mark.slow
+def test_a_cone_with_ten_apex_rows_reconstructs_as_one_closed_surface(monkeypatch):
+    """The default cone laid with 10 rows (not 12) repaired round its apex
+    meets Condition III (worst ratio 0.845, degree 8) and must reconstruct
+    as its B-rep does: one closed genus-0 surface.  It comes out as three
+    closed components (Euler characteristic 6): the backtracking's answer
+    round the apex closes two small pieces off.  Kept as a named regression
+    (xfailed while the reconstruction is wrong, the sampling's conformance
+    asserted) until the selection is fixed; the sampler keeps 12 rows
+    meanwhile."""
+    pytest.importorskip("potpourri3d")
+    from sr33.reconstruct import reconstruct
+    from sr33.samplers import layers
+    from sr33.validators.conditions import sample_conditions
+
+    monkeypatch.setattr(layers, "APEX_REACH", 10)
+    s = shapes.build("cone")
+    r = scan(s)
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    assert rep.max_degree <= 33 and np.nanmax(rep.worst_ratio) <= 0.85  # conforming
+    rec = reconstruct(r.points, 33)
+    st = mesh_stats(rec.triangles, rec.vertices.shape[0])
+    if (st.components, st.euler, st.open_edges) != (1, 2, 0):
+        pytest.xfail(
+            f"issue 21's kind, open: {st.components} components, Euler {st.euler}, "
+            f"{st.open_edges} open edges on a conforming sampling"
+        )
