@@ -51,6 +51,13 @@ This module searches the same space, made tractable by four observations:
    success condition does, and its answer replaces the greedy one only
    when strictly better.  The result reports the edges and samples that
    could not be closed.
+5. **One surface per connected piece of the samples** (the success
+   condition of Section 5).  Components decided on their own can close a
+   piece off (a cone's rings capped one by one round its apex: three closed
+   spheres where the cone is one); every cycle within two graph edges of a
+   detached piece (:func:`_detaching`) goes to the fallback, whose exact
+   selection forbids bubbles, and a selection with a bubble loses to any
+   valid answer.
 """
 
 from __future__ import annotations
@@ -67,7 +74,7 @@ from ._validate import InputError, as_edges, as_points
 from .cycles import CycleSet
 from .graph import cycle_edges, link_is_disk, lookup_edges
 from .mesh import self_intersections, unique_edges, unique_rows
-from .progress import bar
+from .progress import bar, log
 from .rng import Neighbourhoods, k_neighbourhoods
 from .selection import ExactReport, Incidence, exact_selection
 from .tolerance import DEFAULT, Tolerance
@@ -643,6 +650,51 @@ def _front_greedy(prob: _Problem, comp, state, rank, conflicts):
                 push(d)
 
 
+def _detaching(prob: _Problem, state: np.ndarray, edges, n: int, reach: int = 2) -> np.ndarray:
+    """The candidate cycles to decide again where the selection has a
+    detached piece: a piece of the surface (faces linked through shared
+    edges) other than the largest (most faces, then the lowest cycle) on
+    one connected piece of the graph.  Every cycle with a sample within
+    ``reach`` graph edges of a detached piece's samples is returned (the
+    faces that closed the big piece off next to it among them)."""
+    sel = state == 1
+    nc = sel.shape[0]
+    if not sel.any():
+        return np.empty(0, dtype=np.int64)
+    inc = sel[prob.inc_cycle]
+    m = nc + edges.shape[0]
+    g = sparse.csr_matrix(
+        (np.ones(int(inc.sum()), dtype=np.int8), (prob.inc_cycle[inc], prob.inc_edge[inc] + nc)),
+        shape=(m, m),
+    )
+    _, piece = csgraph.connected_components(g, directed=False)
+    gs = sparse.csr_matrix(
+        (np.ones(edges.shape[0], dtype=np.int8), (edges[:, 0], edges[:, 1])), shape=(n, n)
+    )
+    gs = gs + gs.T
+    _, part = csgraph.connected_components(gs, directed=False)
+    faces = np.flatnonzero(sel)
+    of_face = piece[faces]
+    first: dict[int, int] = {}
+    for c, p in zip(faces.tolist(), of_face.tolist()):
+        first.setdefault(p, c)
+    size = np.bincount(of_face)
+    keep: dict[int, int] = {}
+    for p, c in first.items():
+        q = int(part[prob.cycle_vertices[c][0]])
+        best = keep.get(q)
+        if best is None or (size[p], -first[p]) > (size[best], -first[best]):
+            keep[q] = p
+    lost = faces[~np.isin(of_face, list(keep.values()))]
+    if lost.size == 0:
+        return np.empty(0, dtype=np.int64)
+    near = np.zeros(n, dtype=bool)
+    near[np.concatenate([prob.cycle_vertices[c] for c in lost])] = True
+    for _ in range(reach):
+        near = near | (gs @ near.astype(np.int64) > 0)
+    return np.unique(prob.corner_owner[near[prob.corner_vertex]])
+
+
 def _region(prob: _Problem, failed: list[int], lone_edge: np.ndarray, n: int) -> np.ndarray:
     """The cycles the exact selection re-decides: the failed components, and the
     cycles fixed next to them (sharing a sample) because one of their edges lies
@@ -804,6 +856,17 @@ def backtracking(
                 pbar.update(1)
     finally:
         sys.setrecursionlimit(old_limit)
+
+    # Section 5's success condition, one surface per connected piece of the
+    # samples: a component decided on its own can close a piece off (a
+    # cone's apex capped ring by ring); its components go to the fallback,
+    # whose exact selection forbids detached bubbles
+    redo = _detaching(prob, state, e, n)
+    if redo.size:
+        log.debug("backtracking: %d cycles round detached pieces decided again", redo.size)
+        state[redo] = -1
+        failed.extend(redo.tolist())
+        _front_greedy(prob, redo.tolist(), state, rank, conflicts)
 
     exact = ExactReport()
     lone_edge = prob.n_cycles_at_edge == 1

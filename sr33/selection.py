@@ -570,6 +570,17 @@ def exact_selection(
         verts_ = sorted({int(v) for c in comp for v in tab.cycle_vertices[c]})
         links: set[int] = set()  # lazily (all up front: 2x slower, no better)
         before = _score(tab, state, comp, edges_, verts_, lone)
+        # a selection given with a detached bubble is beaten by any valid
+        # answer (they have none): its extra spheres raise the Euler
+        # characteristic the comparison would otherwise prefer
+        comp_set = set(comp)
+        outside = any(
+            int(d) not in comp_set and state[d] == 1
+            for c in comp
+            for e in tab.cycle_edges[c]
+            for d in tab.cycles_at_edge(int(e))
+        )
+        bubbled = bool(_bubbles(tab, state, comp, outside))
         for allow_open in (False, True):
             # coverage first (fast, proven on the library shapes), then the
             # Euler characteristic from that answer: no handle bought with
@@ -591,7 +602,9 @@ def exact_selection(
                     best, prov, hint = new, p, new
             if best is None:
                 continue
-            if _score(tab, best, comp, edges_, verts_, lone).better_than(before, not allow_open):
+            if bubbled or _score(tab, best, comp, edges_, verts_, lone).better_than(
+                before, not allow_open
+            ):
                 state[:] = best
                 improved += 1
                 proven += int(prov)

@@ -829,12 +829,12 @@ def test_turned_rims_disks_and_scoops_meet_condition_iii(sampled, name):
 def test_a_cone_with_ten_apex_rows_reconstructs_as_one_closed_surface(monkeypatch):
     """The default cone laid with 10 rows (not 12) repaired round its apex
     meets Condition III (worst ratio 0.845, degree 8) and must reconstruct
-    as its B-rep does: one closed genus-0 surface.  It comes out as three
-    closed components (Euler characteristic 6): the backtracking's answer
-    round the apex closes two small pieces off.  Kept as a named regression
-    (xfailed while the reconstruction is wrong, the sampling's conformance
-    asserted) until the selection is fixed; the sampler keeps 12 rows
-    meanwhile."""
+    as its B-rep does: one closed genus-0 surface.  It came out as three
+    closed components (Euler characteristic 6): components decided on their
+    own capped the cone ring by ring, and the exact selection's answer
+    (bubble-free) lost to the capped one, whose extra spheres raise the
+    Euler characteristic.  Now a detached piece sends the cycles round it to
+    the fallback, and a bubbled selection loses to any valid answer."""
     pytest.importorskip("potpourri3d")
     from sr33.reconstruct import reconstruct
     from sr33.samplers import layers
@@ -847,8 +847,5 @@ def test_a_cone_with_ten_apex_rows_reconstructs_as_one_closed_surface(monkeypatc
     assert rep.max_degree <= 33 and np.nanmax(rep.worst_ratio) <= 0.85  # conforming
     rec = reconstruct(r.points, 33)
     st = mesh_stats(rec.triangles, rec.vertices.shape[0])
-    if (st.components, st.euler, st.open_edges) != (1, 2, 0):
-        pytest.xfail(
-            f"issue 21's kind, open: {st.components} components, Euler {st.euler}, "
-            f"{st.open_edges} open edges on a conforming sampling"
-        )
+    assert (st.components, st.euler, st.open_edges, st.overloaded_edges) == (1, 2, 0, 0)
+    assert rec.vertices.shape[0] == r.points.shape[0]
