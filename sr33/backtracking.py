@@ -55,9 +55,9 @@ This module searches the same space, made tractable by four observations:
    condition of Section 5).  Components decided on their own can close a
    piece off (a cone's rings capped one by one round its apex: three closed
    spheres where the cone is one); every cycle within two graph edges of a
-   detached piece (:func:`_detaching`) goes to the fallback, whose exact
-   selection forbids bubbles, and a selection with a bubble loses to any
-   valid answer.
+   detached closed piece of the strict search's decisions
+   (:func:`_detaching`) goes to the fallback, whose exact selection forbids
+   bubbles, and a selection with a bubble loses to any valid answer.
 """
 
 from __future__ import annotations
@@ -652,11 +652,12 @@ def _front_greedy(prob: _Problem, comp, state, rank, conflicts):
 
 def _detaching(prob: _Problem, state: np.ndarray, edges, n: int, reach: int = 2) -> np.ndarray:
     """The candidate cycles to decide again where the selection has a
-    detached piece: a piece of the surface (faces linked through shared
-    edges) other than the largest (most faces, then the lowest cycle) on
-    one connected piece of the graph.  Every cycle with a sample within
-    ``reach`` graph edges of a detached piece's samples is returned (the
-    faces that closed the big piece off next to it among them)."""
+    detached piece: a closed piece of the surface (faces linked through
+    shared edges, each of its edges used twice) other than the largest (most
+    faces, then the lowest cycle) on one connected piece of the graph.
+    Every cycle with a sample within ``reach`` graph edges of a detached
+    piece's samples is returned (the faces that closed the big piece off
+    next to it among them)."""
     sel = state == 1
     nc = sel.shape[0]
     if not sel.any():
@@ -685,7 +686,13 @@ def _detaching(prob: _Problem, state: np.ndarray, edges, n: int, reach: int = 2)
         best = keep.get(q)
         if best is None or (size[p], -first[p]) > (size[best], -first[best]):
             keep[q] = p
-    lost = faces[~np.isin(of_face, list(keep.values()))]
+    # only closed pieces (every edge of theirs used twice) are detached: a
+    # piece with a boundary is a part the rest of the selection completes
+    use = np.bincount(prob.inc_edge[inc], minlength=edges.shape[0])
+    open_piece = np.zeros(size.shape[0], dtype=bool)
+    at_open = inc & (use[prob.inc_edge] != 2)
+    open_piece[piece[prob.inc_cycle[at_open]]] = True
+    lost = faces[~np.isin(of_face, list(keep.values())) & ~open_piece[of_face]]
     if lost.size == 0:
         return np.empty(0, dtype=np.int64)
     near = np.zeros(n, dtype=bool)
@@ -861,7 +868,12 @@ def backtracking(
     # samples: a component decided on its own can close a piece off (a
     # cone's apex capped ring by ring); its components go to the fallback,
     # whose exact selection forbids detached bubbles
-    redo = _detaching(prob, state, e, n)
+    # (a failed component's greedy answer is not looked at: the exact
+    # selection re-decides it with bubbles forbidden)
+    decided = state.copy()
+    decided[np.asarray(failed, dtype=np.int64)] = 0
+    redo = _detaching(prob, decided, e, n)
+    redo = np.setdiff1d(redo, np.asarray(failed, dtype=np.int64))
     if redo.size:
         log.debug("backtracking: %d cycles round detached pieces decided again", redo.size)
         state[redo] = -1
