@@ -269,11 +269,8 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
             cache[key] = _layout(key, 1.0)
         lay = cache[key]
         uv, rim, ring = lay.uv * h, lay.rim, lay.ring
-        last = int(ring.max())
-        for j, r in ((0, rf.radii[0]), (last, rf.radii[-1] if len(rf.radii) > 1 else None)):
-            on = ring == j
-            if r is not None and on.any():
-                uv[on] *= r / np.linalg.norm(uv[on], axis=1)[:, None]
+        radius = np.where(ring == 0, rf.radii[0], rf.radii[-1])[rim]  # outer rim, inner rim
+        uv[rim] *= (radius / np.linalg.norm(uv[rim], axis=1))[:, None]
         ex = perpendicular(rf.normal)
         ey = np.cross(rf.normal, ex)
         q = s.points - rf.centre

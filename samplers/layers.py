@@ -94,24 +94,19 @@ def _arcs(face, to2d, across=()) -> list[Arc]:
     return out
 
 
-def _nearest_curve(arcs: list, p: np.ndarray) -> np.ndarray:
-    """Index of the curve (arc or line) nearest to each point."""
-    return np.argmin(_distances(arcs, p), axis=1)
-
-
 def _project_onto(curves: list, margin: float):
     """Map each point to the nearest point of its nearest curve (arcs and
     lines), at least ``margin`` from the curve's ends."""
 
-    lines = [k for k, c in enumerate(curves) if isinstance(c, _Line)]
-    edges = _Edges([curves[k] for k in lines])
+    both = _Curves(curves)
+    edges = both.edges
     column = np.full(len(curves), -1)
-    column[lines] = np.arange(len(lines))
+    column[both.lines] = np.arange(len(both.lines))
     # a line's ends are kept ``margin`` away: its parameter within [m, 1 - m]
-    m = np.array([margin / float(norm(curves[k].b - curves[k].a)) for k in lines])
+    m = margin / np.sqrt(edges.dd)
 
     def project(p: np.ndarray) -> np.ndarray:
-        which = _nearest_curve(curves, p)
+        which = np.argmin(both.distances(p), axis=1)
         out = p.copy()
         # the lines at once (the same operations as _Line.project, point by point)
         on = column[which]
@@ -141,12 +136,16 @@ def _ghosts(arcs: list[Arc], sides: list[float], h: float):
     (``sides``: +1 where the face is inside the arc's circle, so outwards).
     """
 
+    curves = _Curves(arcs)
+
     def ghosts(p: np.ndarray) -> np.ndarray:
         # the sliding samples on an arc (those on a straight edge have the frame)
-        p = p[np.min(np.stack([a.distance(p) for a in arcs], axis=1), axis=1) < 1e-6 * h]
-        if p.shape[0] == 0:
+        d = curves.distances(p)
+        on = d.min(axis=1) < 1e-6 * h
+        if not on.any():
             return np.empty((0, 2))
-        which = _nearest_curve(arcs, p)
+        p = p[on]
+        which = np.argmin(d[on], axis=1)
         out = []
         for k, a in enumerate(arcs):
             q = p[which == k]
@@ -251,16 +250,24 @@ class _Edges:
         return np.sqrt((q * q).sum(axis=-1))
 
 
-def _distances(curves: list, p: np.ndarray) -> np.ndarray:
-    """(n, m): every point's distance to every curve (arcs and lines, in order)."""
-    out = np.empty((p.shape[0], len(curves)))
-    lines = [k for k, c in enumerate(curves) if isinstance(c, _Line)]
-    if lines:
-        out[:, lines] = _Edges([curves[k] for k in lines]).distance(p)
-    for k, c in enumerate(curves):
-        if not isinstance(c, _Line):
-            out[:, k] = c.distance(p)
-    return out
+class _Curves:
+    """Arcs and lines together (in order), the lines' geometry laid out once:
+    the repair asks for distances and nearest curves at every step."""
+
+    def __init__(self, curves: list):
+        self.curves = list(curves)
+        self.lines = [k for k, c in enumerate(self.curves) if isinstance(c, _Line)]
+        self.edges = _Edges([self.curves[k] for k in self.lines])
+
+    def distances(self, p: np.ndarray) -> np.ndarray:
+        """(n, m): every point's distance to every curve."""
+        out = np.empty((p.shape[0], len(self.curves)))
+        if self.lines:
+            out[:, self.lines] = self.edges.distance(p)
+        for k, c in enumerate(self.curves):
+            if not isinstance(c, _Line):
+                out[:, k] = c.distance(p)
+        return out
 
 
 def _slanted(face, row_dir, u: np.ndarray) -> bool:
@@ -578,16 +585,18 @@ def repair_planar_faces(
                 judge_frame=True,
                 max_edits=None if arcs else (FOLLOW_EDITS if follow else LINE_EDITS),
             )
-            done[key] = repair(uv, free, h, **args)
-            # stuck: allow wider cells (only round whole circles: on cutcube's
-            # face whose scoop arc ends on the cube's edge it opened the
+            # stuck: wider cells only round whole circles (on cutcube's face
+            # whose scoop arc ends on the cube's edge they opened the
             # reconstruction there, 5 open edges)
-            if arcs and all(a.closed for a in arcs) and done[key].worst >= STUCK:
-                again = repair(uv, free, h, wide=RETRY_WIDE, **args)
-                if again.worst < done[key].worst:
-                    done[key] = again
-            if done[key].worst >= STUCK and done[key].bad <= FEW_BAD:
-                done[key] = split_corners(uv, free, h, done[key], **args)
+            done[key] = unstuck(
+                uv,
+                free,
+                h,
+                repair(uv, free, h, **args),
+                STUCK,
+                wide=bool(arcs) and all(a.closed for a in arcs),
+                **args,
+            )
         r = done[key]
         if outline is not None and outline not in outlines:
             outlines[outline] = (uv.copy(), r)
@@ -621,6 +630,22 @@ def repair_planar_faces(
         }
         reports = [redone.get(x["face"], x) for x in reports]
     return reports
+
+
+def unstuck(uv, free, h: float, first: Repaired, stuck: float, wide: bool = True, **kwargs):
+    """A repair's answer ``first`` retried where it is stuck at or above
+    ``stuck``: again with cells of circumradius up to ``RETRY_WIDE`` h (when
+    ``wide``), then, with at most ``FEW_BAD`` bad triangles, with its corners
+    split (:func:`sr33.samplers.repair.split_corners`); the lowest worst
+    ratio is kept.  ``kwargs`` are the repair's own."""
+    r = first
+    if wide and r.worst >= stuck:
+        again = repair(uv, free, h, wide=RETRY_WIDE, **kwargs)
+        if again.worst < r.worst:
+            r = again
+    if r.worst >= stuck and r.bad <= FEW_BAD:
+        r = split_corners(uv, free, h, r, **kwargs)  # r itself unless it beats it
+    return r
 
 
 def _answer_for(first: tuple, uv: np.ndarray, tol: float) -> Repaired:

@@ -28,8 +28,8 @@ from sr33.mesh import dot, norm
 
 from .chart import Arc, Raster, arc_clamp, arc_sides, segment_distance
 from .faces import boundary_segments, goes_round, perpendicular, rims_sampled
-from .layers import FEW_BAD, POLE_GOOD, RASTER, RETRY_WIDE
-from .repair import repair, split_corners
+from .layers import POLE_GOOD, RASTER, unstuck
+from .repair import repair
 from .samples import Samples
 
 FRAME_REACH = 2.5  # the neighbours' samples this near a rim (times h) frame the repair
@@ -229,17 +229,8 @@ def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=N
     own[idx] = True
     frame = _rim_frame(face, arcs, sides, to2d, s, own, h)
     args = dict(inside=raster, clamp=arc_clamp(arcs, sides, h), frame=frame, judge_frame=True)
-    r = repair(uv, free, h, **args)
-    if r.worst >= MAP_GOOD:
-        # the map's ratios are the sphere's up to the scale's change across
-        # a triangle: ending near 0.85 on the map is not enough (cutcube's
-        # scoop, turned: 0.849 on the map, 0.858 geodesically).  Wider cells
-        # and, where few are bad, split corners; the lowest worst is kept
-        wide = repair(uv, free, h, wide=RETRY_WIDE, **args)
-        if wide.worst < r.worst:
-            r = wide
-        if r.worst >= MAP_GOOD and r.bad <= FEW_BAD:
-            split = split_corners(uv, free, h, r, **args)
-            if split.worst < r.worst:
-                r = split
+    # the map's ratios are the sphere's up to the scale's change across a
+    # triangle: ending near 0.85 on the map is not enough (cutcube's scoop,
+    # turned: 0.849 on the map, 0.858 geodesically)
+    r = unstuck(uv, free, h, repair(uv, free, h, **args), MAP_GOOD, **args)
     return s.put(idx, r, to2d.inverse(r.uv), fi, "sphere")

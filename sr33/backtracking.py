@@ -650,6 +650,18 @@ def _front_greedy(prob: _Problem, comp, state, rank, conflicts):
                 push(d)
 
 
+def _edge_linked(prob: _Problem, mask: np.ndarray, n_edges: int) -> np.ndarray:
+    """Component labels of the cycles in ``mask`` linked through shared edges
+    (indexed by cycle; the graph's other nodes are the edges)."""
+    nc = mask.shape[0]
+    inc = mask[prob.inc_cycle]
+    g = sparse.csr_matrix(
+        (np.ones(int(inc.sum()), dtype=np.int8), (prob.inc_cycle[inc], prob.inc_edge[inc] + nc)),
+        shape=(nc + n_edges, nc + n_edges),
+    )
+    return csgraph.connected_components(g, directed=False)[1]
+
+
 def _detaching(prob: _Problem, state: np.ndarray, edges, n: int, reach: int = 2) -> np.ndarray:
     """The candidate cycles to decide again where the selection has a
     detached piece: a closed piece of the surface (faces linked through
@@ -659,16 +671,10 @@ def _detaching(prob: _Problem, state: np.ndarray, edges, n: int, reach: int = 2)
     piece's samples is returned (the faces that closed the big piece off
     next to it among them)."""
     sel = state == 1
-    nc = sel.shape[0]
     if not sel.any():
         return np.empty(0, dtype=np.int64)
     inc = sel[prob.inc_cycle]
-    m = nc + edges.shape[0]
-    g = sparse.csr_matrix(
-        (np.ones(int(inc.sum()), dtype=np.int8), (prob.inc_cycle[inc], prob.inc_edge[inc] + nc)),
-        shape=(m, m),
-    )
-    _, piece = csgraph.connected_components(g, directed=False)
+    piece = _edge_linked(prob, sel, edges.shape[0])
     gs = sparse.csr_matrix(
         (np.ones(edges.shape[0], dtype=np.int8), (edges[:, 0], edges[:, 1])), shape=(n, n)
     )
@@ -825,16 +831,7 @@ def backtracking(
     free_idx = np.flatnonzero(free)
     comps: list[list[int]] = []
     if free_idx.shape[0]:
-        inc = free[prob.inc_cycle]
-        b = sparse.csr_matrix(
-            (
-                np.ones(int(inc.sum()), dtype=np.int8),
-                (prob.inc_cycle[inc], prob.inc_edge[inc] + nc),
-            ),
-            shape=(nc + e.shape[0], nc + e.shape[0]),
-        )
-        ncomp, labels = csgraph.connected_components(b, directed=False)
-        lab = labels[free_idx]
+        lab = _edge_linked(prob, free, e.shape[0])[free_idx]
         order = np.argsort(lab, kind="stable")
         lab_sorted = lab[order]
         splits = np.flatnonzero(np.diff(lab_sorted)) + 1
@@ -865,15 +862,14 @@ def backtracking(
         sys.setrecursionlimit(old_limit)
 
     # Section 5's success condition, one surface per connected piece of the
-    # samples: a component decided on its own can close a piece off (a
-    # cone's apex capped ring by ring); its components go to the fallback,
-    # whose exact selection forbids detached bubbles
-    # (a failed component's greedy answer is not looked at: the exact
-    # selection re-decides it with bubbles forbidden)
+    # samples: components decided on their own can close a piece off (a
+    # cone's apex capped ring by ring); the cycles round it go to the
+    # fallback, whose exact selection forbids detached bubbles (the failed
+    # components' greedy answers are left out: it re-decides them anyway)
+    failed_idx = np.asarray(failed, dtype=np.int64)
     decided = state.copy()
-    decided[np.asarray(failed, dtype=np.int64)] = 0
-    redo = _detaching(prob, decided, e, n)
-    redo = np.setdiff1d(redo, np.asarray(failed, dtype=np.int64))
+    decided[failed_idx] = 0
+    redo = np.setdiff1d(_detaching(prob, decided, e, n), failed_idx)
     if redo.size:
         log.debug("backtracking: %d cycles round detached pieces decided again", redo.size)
         state[redo] = -1

@@ -263,6 +263,17 @@ def _bubbles(tab: _Tables, state: np.ndarray, cycles, outside_faces: bool) -> li
     return [grp for j, grp in enumerate(groups) if j != keep]
 
 
+def _touches_outside(tab: _Tables, state: np.ndarray, cycles) -> bool:
+    """Whether a selected cycle outside ``cycles`` shares an edge with one of them."""
+    inside = set(cycles)
+    return any(
+        int(d) not in inside and state[d] == 1
+        for c in cycles
+        for e in tab.cycle_edges[c]
+        for d in tab.cycles_at_edge(int(e))
+    )
+
+
 def _connect(m, tab, state, cycles, cyc_set, x) -> None:
     """Every face of the region reaches a face outside it through faces.
 
@@ -440,12 +451,7 @@ def _solve_component(
         add_link(v)
     # a component next to faces outside it must reach them; one that touches
     # none (a separate object) keeps its largest piece
-    outside = any(
-        int(d) not in cyc_set and state[d] == 1
-        for c in cycles
-        for e in tab.cycle_edges[c]
-        for d in tab.cycles_at_edge(int(e))
-    )
+    outside = _touches_outside(tab, state, cycles)
     if outside:
         _connect(m, tab, state, cycles, cyc_set, x)
     elif not allow_open:
@@ -573,14 +579,7 @@ def exact_selection(
         # a selection given with a detached bubble is beaten by any valid
         # answer (they have none): its extra spheres raise the Euler
         # characteristic the comparison would otherwise prefer
-        comp_set = set(comp)
-        outside = any(
-            int(d) not in comp_set and state[d] == 1
-            for c in comp
-            for e in tab.cycle_edges[c]
-            for d in tab.cycles_at_edge(int(e))
-        )
-        bubbled = bool(_bubbles(tab, state, comp, outside))
+        bubbled = bool(_bubbles(tab, state, comp, _touches_outside(tab, state, comp)))
         for allow_open in (False, True):
             # coverage first (fast, proven on the library shapes), then the
             # Euler characteristic from that answer: no handle bought with
