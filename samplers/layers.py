@@ -66,6 +66,9 @@ FOLLOW_EDITS = 160  # ... when some of them slide with the columns of the face a
 STUCK = 0.85
 RETRY_WIDE = 1.2  # a stuck face's repair runs again with circumradii up to this (times h)
 FEW_BAD = 10  # a repair left with at most this many bad triangles gets its corners split
+#: most further rounds of a planar face still stuck after its repair, each from
+#: the answer before (conebox's top: 0.853, 0.856, 0.859, ... 0.842 at the 11th)
+AGAIN_ROUNDS = 16
 
 
 def _arcs(face, to2d, across=()) -> list[Arc]:
@@ -415,7 +418,7 @@ def repair_planar_faces(
     size: float,
     row_dirs=None,
     skip=frozenset(),
-    again: bool = True,
+    again: int = AGAIN_ROUNDS,
     walls: dict[int, np.ndarray] | None = None,
 ) -> list[dict]:
     """Repair the boundary layer of every planar face bounded by circular arcs
@@ -455,10 +458,11 @@ def repair_planar_faces(
     get one answer even where a gap was filled on one of them only (a
     prism's two ends; their sides' columns run straight from one to the
     other).  A face still left with at most ``FEW_BAD`` triangles at or
-    above ``STUCK`` is repaired once more from that answer (``again``;
-    fillet_box's bottom: two of 0.884 where its corners' arcs meet the
-    rows, none after the second run).  Returns one report per repaired
-    face.
+    above ``STUCK`` is repaired again from that answer, round after round
+    while it stays stuck, at most ``again`` rounds (fillet_box's bottom: two
+    of 0.884 where its corners' arcs meet the rows, none after the second
+    run; conebox's top, round its cone's rim: 0.853 first, 0.842 after the
+    eleventh).  Returns one report per repaired face.
     """
     reports = []
     done: dict[tuple, object] = {}
@@ -622,11 +626,13 @@ def repair_planar_faces(
                 walls[a.wall] = pts3[a.distance(r.uv) < tol]
     _follow_columns(s, shifts, faces, tol)
     stuck = {x["face"] for x in reports if x["worst"] >= STUCK and x["bad"] <= FEW_BAD}
-    if again and stuck:
+    if again > 0 and stuck:
         rest = set(range(len(faces))) - stuck
         redone = {
             x["face"]: x
-            for x in repair_planar_faces(occ, s, h, size, row_dirs, rest, again=False, walls=walls)
+            for x in repair_planar_faces(
+                occ, s, h, size, row_dirs, rest, again=again - 1, walls=walls
+            )
         }
         reports = [redone.get(x["face"], x) for x in reports]
     return reports

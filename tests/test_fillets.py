@@ -90,11 +90,11 @@ def test_corner_octants_are_one_repaired_answer(box):
 def test_the_bottoms_second_run_is_never_worse(box):
     """The bottom keeps its scan rows and their boundary-layer repair; a
     planar face left with a few triangles at or above √3/2 is repaired once
-    more from that answer (repair_planar_faces' ``again``; the bottom was
+    from that answer (repair_planar_faces' ``again`` rounds; the bottom was
     left with two of 0.884 where a corner's arc meets the rows before the
     repair made several attempts).  The second run keeps the better answer:
     with it the bottom is never worse than without, and it meets III-ii."""
-    from sr33.samplers.layers import repair_planar_faces
+    from sr33.samplers.layers import AGAIN_ROUNDS, repair_planar_faces
     from sr33.samplers.samples import Samples
 
     s, r = box
@@ -102,10 +102,10 @@ def test_the_bottoms_second_run_is_never_worse(box):
     assert len(bottom) == 1 and bottom[0]["worst"] < np.sqrt(3) / 2
     plain = scan(s, repair=False)
     answers = {}
-    for again in (False, True):
+    for again in (0, AGAIN_ROUNDS):
         bag = Samples(plain.points, plain.line_id, plain.face_id, plain.on_feature)
         (got,) = repair_planar_faces(s.solid, bag, r.meta["spacing"], s.size, again=again)
         answers[again] = got
-    assert answers[True]["face"] == answers[False]["face"] == bottom[0]["face"]
-    assert answers[True]["worst"] <= answers[False]["worst"]
-    assert answers[True]["worst"] < np.sqrt(3) / 2
+    assert answers[AGAIN_ROUNDS]["face"] == answers[0]["face"] == bottom[0]["face"]
+    assert answers[AGAIN_ROUNDS]["worst"] <= answers[0]["worst"]
+    assert answers[AGAIN_ROUNDS]["worst"] < np.sqrt(3) / 2
