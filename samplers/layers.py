@@ -818,6 +818,8 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         loc = np.array(pos.Location().Coord())
         if norm(loc - apex) < tol:
             continue
+        corners = np.array([v.toTuple() for v in face.Vertices()], dtype=np.float64)
+        frustum = not (norm(corners - apex) < tol).any()
         axis = (loc - apex) / norm(loc - apex)
         ex = np.array(pos.XDirection().Coord())
         ey = np.cross(axis, ex)
@@ -836,6 +838,17 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         if rim.size < 3:
             continue  # the rim is a smooth edge (cone_tip): left to the scan rows
         slant = top / math.cos(abs(cone.SemiAngle()))
+        inner = None
+        if frustum:
+            # the small rim: the rings stop short of it, the band between is
+            # repaired with the rim's samples fixed (the rings must not run
+            # on to the apex, off the face)
+            bottom = along[cand].min()
+            low = cand[s.on_feature[cand] & (np.abs(along[cand] - bottom) < tol * 10)]
+            if low.size < 3:
+                continue
+            low_ang = np.sort(np.arctan2(dot(q[low], ey), dot(q[low], ex)) % (2 * math.pi))
+            inner = (bottom / math.cos(abs(cone.SemiAngle())), low_ang)
         rows = steps(slant, h)
         t = slant / rows
         rim_ang = np.sort(np.arctan2(dot(q[rim], ey), dot(q[rim], ex)) % (2 * math.pi))
@@ -854,6 +867,8 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         designed = plan.at.size - (reach - 1) if plan.halves.any() else 0
         for j, at_j in enumerate(plan.at, start=1):
             rho = slant - at_j
+            if inner is not None and rho < inner[0] + INNER_GAP * t:
+                break
             if plan.halves[j - 1]:
                 ang = ang[::2]
             elif j > designed:
@@ -864,7 +879,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
             ang_l.append(ang)
             row_l.append(np.full(ang.size, j - 1))
         keep = APEX_KEEP
-        fan = _apex_fan(2 * math.pi * sin_a) if rho_l else None
+        fan = _apex_fan(2 * math.pi * sin_a) if rho_l and inner is None else None
         if fan is not None:  # the ring round the apex becomes the designed fan
             r1 = rho_l[-1][0]
             rho_l[-1], ang_l[-1], row_l[-1] = fan.ring(r1, ang_l[-1][0], row_l[-1][0])
@@ -875,8 +890,13 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         row_a = np.concatenate(row_l) if row_l else np.empty(0, np.int64)
         bad = worst = None
         if rho_a.size:
-            got = _repair_developed(rho_a, ang_a, row_a, rim_ang, slant, sin_a, t, keep)
-            if got[4] >= SQRT3_2:  # stuck: once more, wider, the apex's neighbourhood settled
+            # a frustum's band is mended from the margin (no apex to spare)
+            broken_at = SQRT3_2 if inner is None else STUCK
+            got = _repair_developed(
+                rho_a, ang_a, row_a, rim_ang, slant, sin_a, t, keep, broken_at, inner=inner
+            )
+            # stuck: once more, wider, the apex's neighbourhood settled
+            if got[4] >= broken_at:
                 wide = _repair_developed(
                     *got[:3],
                     rim_ang,
@@ -884,7 +904,9 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
                     sin_a,
                     t,
                     max(keep, APEX_SETTLED),
+                    broken_at,
                     movable=WIDE_MOVABLE,
+                    inner=inner,
                 )
                 got = wide if wide[4] < got[4] else got
             rho_a, ang_a, row_a, bad, worst = got
@@ -922,6 +944,7 @@ FAN_KEEP = 1.3  # ... or, round a designed fan, this near (times the fan's radiu
 FAN_RATIO = 0.85  # a fan's triangles keep their ratio (Condition III-ii) below this
 FAN_ANGLES = 165.0  # ... and its spokes' opposite angles below this sum (degrees)
 WIDE_MOVABLE = 6.0  # a cone's repair left a ratio above sqrt(3)/2: again, this far (times t)
+INNER_GAP = 0.6  # a frustum's rings stop this far (times t) short of its small rim
 
 
 def _fan_figures(radii: np.ndarray, phi):
@@ -1042,6 +1065,7 @@ def _repair_developed(
     apex_keep: float = APEX_KEEP,
     broken_at: float = SQRT3_2,
     movable: float = MOVABLE,
+    inner: tuple | None = None,
 ):
     """Repair a cone's rings where they break Condition III-ii, on the cone's development.
 
@@ -1066,7 +1090,11 @@ def _repair_developed(
     ``apex_keep`` (times t) sets the fixed neighbourhood of the apex; the
     triangles to mend are those whose ratio is ``broken_at`` or more on the
     development, and the samples within ``movable`` (times t) of them may
-    move.  Returns the new (rho, ang, row; -1 for an added sample), the
+    move.  A frustum's face ends at a small rim, ``inner`` = (its slant
+    distance from the apex, its samples' angles): the development is then an
+    annular sector, the small rim's samples are fixed like the rim's (in
+    place of the apex) and the samples stay at least t / 4 off both rims.
+    Returns the new (rho, ang, row; -1 for an added sample), the
     triangles left above the repair's margin and the worst ratio.
     """
     full = sin_a >= 1.0 - 1e-12
@@ -1075,12 +1103,18 @@ def _repair_developed(
     uv = np.stack([rho * np.cos(psi), rho * np.sin(psi)], axis=1)
     rim_psi = rim_ang * sin_a
     rim = slant * np.stack([np.cos(rim_psi), np.sin(rim_psi)], axis=1)
-    allp = np.vstack([uv, rim, np.zeros((1, 2))])
+    if inner is None:
+        allp = np.vstack([uv, rim, np.zeros((1, 2))])
+        hole = 0.0
+    else:
+        hole, low_ang = inner
+        low_psi = low_ang * sin_a
+        allp = np.vstack([uv, rim, hole * np.stack([np.cos(low_psi), np.sin(low_psi)], axis=1)])
 
     def inside(c: np.ndarray) -> np.ndarray:
         r = np.linalg.norm(c, axis=1)
         a = np.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
-        return (r < slant) & (full | (a < theta))
+        return (r < slant) & (r > hole) & (full | (a < theta))
 
     n = uv.shape[0]
     # where the rings break Condition III-ii: the triangles to mend (across the
@@ -1094,17 +1128,17 @@ def _repair_developed(
     if broken.shape[0]:
         tree = cKDTree(broken)
         near = np.any([tree.query(q)[0] <= movable * t for q in copies(uv, turn)], axis=0)
-    free = near & (rho > apex_keep * t)
+    free = near & (rho > apex_keep * t) if inner is None else near
     if not free.any():
         return rho, ang, row, 0, 0.0
-    fixed_free = np.r_[free, np.zeros(rim.shape[0] + 1, dtype=bool)]
+    fixed_free = np.r_[free, np.zeros(allp.shape[0] - n, dtype=bool)]
 
     out = repair(
         allp,
         fixed_free,
         t,
         inside=inside,
-        clamp=radial_clamp(0.0, slant - 0.25 * t),
+        clamp=radial_clamp(hole + 0.25 * t if inner is not None else 0.0, slant - 0.25 * t),
         turn=turn,
     )
     mine = out.origin < n  # not the rim nor the apex

@@ -849,3 +849,24 @@ def test_a_cone_with_ten_apex_rows_reconstructs_as_one_closed_surface(monkeypatc
     st = mesh_stats(rec.triangles, rec.vertices.shape[0])
     assert (st.components, st.euler, st.open_edges, st.overloaded_edges) == (1, 2, 0, 0)
     assert rec.vertices.shape[0] == r.points.shape[0]
+
+
+def test_a_frustums_samples_stay_on_its_surface():
+    """A frustum's cone does not reach its apex: the cone layout
+    (:func:`sr33.samplers.layers.lattice_cone_faces`) laid its rings on to
+    the apex, past the small rim and off the solid (51 samples up to 7 h
+    above the top of this frustum, 3 h across).  Its rings now stop short of
+    the small rim and the band between is repaired on the development with
+    the rim's samples fixed: every sample lies on the surface, within the
+    truth tessellation's own chordal error, and the cone is laid in rings."""
+    import cadquery as cq
+
+    from sr33.validators.fidelity import distance_to_surface
+
+    s = shapes.from_cad(cq.Solid.makeCone(0.2, 0.04, 0.4, pnt=cq.Vector(0, 0, -0.2)))
+    r = scan(s, target_points=3000)
+    h = r.meta["spacing"]
+    assert distance_to_surface(r.points, s.truth_vertices, s.truth_triangles).max() < 0.05 * h
+    top = r.points[:, 2].max()
+    assert top == pytest.approx(0.2, abs=1e-9)
+    assert [x["kind"] for x in r.meta["repairs"]].count("cone rings") == 1
