@@ -282,3 +282,36 @@ def test_validate_exits_1_when_input_points_are_not_vertices(tmp_path, capsys):
     capsys.readouterr()
     assert main(["validate", str(tmp_path / "m.ply"), "--points", str(tmp_path / "p.xyz")]) == 1
     assert "input points not vertices  1" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_crowded_samples_are_judged_like_the_plane():
+    """On a flat face the geodesic DT_M is the planar Delaunay triangulation.
+    A frustum's top disk, laid and repaired round its centre, has samples
+    0.6 spacings apart there: at the default resolution (a third of the
+    median spacing) their cells were resolved by one or two truth vertices
+    and the check judged a triangle of 0.979 that the plane does not have
+    (the disk's worst is 0.81).  Refined round crowded samples
+    (``conditions._LocalResolution``), every sample of the disk's interior
+    gets its planar worst ratio, up to the other diagonal of a near-cocircular
+    quad of the disk's rings (a tie either way: 0.0125 at most, measured)."""
+    pytest.importorskip("cadquery")
+    import cadquery as cq
+    from scipy.spatial import Delaunay
+
+    from sr33.mesh import triangle_ratios
+    from sr33.samplers import shapes
+    from sr33.samplers.scanline import scan
+
+    s = shapes.from_cad(cq.Solid.makeCone(0.5, 0.2, 0.8, pnt=cq.Vector(0, 0, -0.4)))
+    r = scan(s, target_points=6000)
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    top = np.flatnonzero(np.abs(r.points[:, 2] - 0.4) < 1e-9)
+    p = r.points[top]
+    tri = Delaunay(p[:, :2]).simplices
+    ratio = triangle_ratios(p, tri)
+    planar = np.zeros(top.size)
+    np.maximum.at(planar, tri.ravel(), np.repeat(ratio, 3))
+    inner = np.hypot(p[:, 0], p[:, 1]) < 0.2 - 2 * r.meta["spacing"]
+    assert inner.sum() > 100
+    np.testing.assert_allclose(rep.worst_ratio[top[inner]], planar[inner], atol=0.03)

@@ -34,7 +34,9 @@ def _edges_of(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return inc.edges, inc.edge_of.reshape(-1, 3)
 
 
-def refine_to_edge_length(vertices, triangles, max_edge: float, *, max_triangles: int = 12_000_000):
+def refine_to_edge_length(
+    vertices, triangles, max_edge: float, *, local=None, max_triangles: int = 12_000_000
+):
     """Split triangles until no edge is longer than ``max_edge``.
 
     Parameters
@@ -43,6 +45,10 @@ def refine_to_edge_length(vertices, triangles, max_edge: float, *, max_triangles
     triangles : (t, 3) array_like of int
     max_edge : float
         Longest edge allowed in the result.
+    local : callable, optional
+        ``local(midpoints) -> (m,) lengths``: a shorter limit where it is
+        below ``max_edge``, read at each edge's midpoint (finer round crowded
+        samples, :func:`sr33.validators.conditions.sample_conditions`).
     max_triangles : int
         Refuse (``ValueError``) when the result would exceed this many triangles.
 
@@ -71,6 +77,12 @@ def refine_to_edge_length(vertices, triangles, max_edge: float, *, max_triangles
         edges, tedge = _edges_of(t)
         length = np.linalg.norm(v[edges[:, 0]] - v[edges[:, 1]], axis=1)
         split = length > max_edge
+        if local is not None:
+            # only edges longer than the shortest local limit can be split
+            maybe = np.flatnonzero(~split & (length > local.floor))
+            if maybe.size:
+                mid = 0.5 * (v[edges[maybe, 0]] + v[edges[maybe, 1]])
+                split[maybe] = length[maybe] > local(mid)
         if not split.any():
             return v, t
         # a triangle splitting any edge splits its longest one too (Rivara), so
