@@ -66,6 +66,10 @@ def test_insertion_makes_each_sample_a_vertex():
 
 
 def test_two_samples_on_one_vertex_is_an_error():
+    """Near-duplicate samples (a sampler's defect) cannot both become a
+    vertex: the error names them and how far apart they are."""
     v, f = octahedron()
-    with pytest.raises(ValueError, match="two samples fall on one of its vertices"):
+    with pytest.raises(
+        ValueError, match=r"^samples 0 and 1 fall on one vertex .*\(1.41e-09 apart\)"
+    ):
         insert_points(v, f, [[0.0, 0.0, 1.0], [0.0, 1e-9, 1.0 - 1e-9]])

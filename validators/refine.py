@@ -150,7 +150,8 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
     Raises
     ------
     ValueError
-        When two points fall on the same vertex (the mesh is too coarse).
+        When two points fall on the same vertex (near-duplicate points, or
+        the mesh is too coarse); the message names them and their distance.
 
     Examples
     --------
@@ -219,8 +220,12 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
             if w[corner] > 1 - SNAP:
                 vid = int(t[ti, corner])
                 if vid in snapped:
+                    j = int(np.flatnonzero(index == vid)[0])
+                    gap = float(np.linalg.norm(pts[i] - pts[j]))
                     raise ValueError(
-                        "the truth mesh is too coarse: two samples fall on one of its vertices"
+                        f"samples {min(i, j)} and {max(i, j)} fall on one vertex of the truth "
+                        f"mesh ({gap:.3g} apart): near-duplicate samples, or a truth mesh too "
+                        "coarse for them"
                     )
                 snapped.add(vid)
                 v[vid] = pts[i]
