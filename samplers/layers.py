@@ -819,7 +819,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         if norm(loc - apex) < tol:
             continue
         corners = np.array([v.toTuple() for v in face.Vertices()], dtype=np.float64)
-        frustum = not (norm(corners - apex) < tol).any()
+        frustum = not (norm(corners.reshape(-1, 3) - apex) < tol).any()  # no vertex at its apex
         axis = (loc - apex) / norm(loc - apex)
         ex = np.array(pos.XDirection().Coord())
         ey = np.cross(axis, ex)

@@ -73,3 +73,26 @@ def test_two_samples_on_one_vertex_is_an_error():
         ValueError, match=r"^samples 0 and 1 fall on one vertex .*\(1.41e-09 apart\)"
     ):
         insert_points(v, f, [[0.0, 0.0, 1.0], [0.0, 1e-9, 1.0 - 1e-9]])
+
+
+def test_a_local_limit_refines_only_where_it_is_shorter():
+    """``local`` (any callable of the edges' midpoints) sets a shorter limit
+    where it is below ``max_edge``: finer there, as before elsewhere, still
+    one conforming surface of the same area."""
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    rv, rt = refine_to_edge_length(
+        v, [[0, 1, 2]], 0.5, local=lambda m: np.where(m[:, 0] < 0.3, 0.1, 0.5)
+    )
+    a, b = rv[rt], np.roll(rv[rt], 1, axis=1)
+    length, mid = np.linalg.norm(a - b, axis=2), 0.5 * (a + b)
+    assert length.max() <= 0.5
+    assert length[mid[..., 0] < 0.3].max() <= 0.1
+    assert length[mid[..., 0] > 0.6].min() > 0.1  # not refined where the limit is 0.5
+    plain, _ = refine_to_edge_length(v, [[0, 1, 2]], 0.5)
+    assert rv.shape[0] > plain.shape[0]
+    s = mesh_stats(rt, rv.shape[0])
+    assert (s.overloaded_edges, s.euler, s.components) == (0, 1, 1)  # one disk
+    area = np.linalg.norm(
+        np.cross(rv[rt[:, 1]] - rv[rt[:, 0]], rv[rt[:, 2]] - rv[rt[:, 0]]), axis=1
+    )
+    assert area.sum() / 2 == pytest.approx(0.5, abs=1e-12)

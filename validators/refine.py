@@ -48,7 +48,9 @@ def refine_to_edge_length(
     local : callable, optional
         ``local(midpoints) -> (m,) lengths``: a shorter limit where it is
         below ``max_edge``, read at each edge's midpoint (finer round crowded
-        samples, :func:`sr33.validators.conditions.sample_conditions`).
+        samples, :func:`sr33.validators.conditions.sample_conditions`); its
+        attribute ``floor``, when it has one, is a lower bound of its values
+        (edges no longer than it are not asked about).
     max_triangles : int
         Refuse (``ValueError``) when the result would exceed this many triangles.
 
@@ -79,7 +81,7 @@ def refine_to_edge_length(
         split = length > max_edge
         if local is not None:
             # only edges longer than the shortest local limit can be split
-            maybe = np.flatnonzero(~split & (length > local.floor))
+            maybe = np.flatnonzero(~split & (length > getattr(local, "floor", 0.0)))
             if maybe.size:
                 mid = 0.5 * (v[edges[maybe, 0]] + v[edges[maybe, 1]])
                 split[maybe] = length[maybe] > local(mid)
