@@ -825,7 +825,13 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         ey = np.cross(axis, ex)
         tan_a = math.tan(abs(cone.SemiAngle()))
         sin_a = math.sin(abs(cone.SemiAngle()))
+        cos_a = math.cos(abs(cone.SemiAngle()))
         q = s.points - apex
+
+        def angles(idx, q=q, ex=ex, ey=ey):
+            """The samples' angles about the axis, ascending in [0, 2 pi)."""
+            return np.sort(np.arctan2(dot(q[idx], ey), dot(q[idx], ex)) % (2 * math.pi))
+
         along = dot(q, axis)
         radial = np.linalg.norm(q - along[:, None] * axis, axis=1)
         on = np.abs(radial - along * tan_a) < tol * 10
@@ -837,7 +843,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         rim = cand[s.on_feature[cand] & (np.abs(along[cand] - top) < tol * 10)]
         if rim.size < 3:
             continue  # the rim is a smooth edge (cone_tip): left to the scan rows
-        slant = top / math.cos(abs(cone.SemiAngle()))
+        slant = top / cos_a
         inner = None
         if frustum:
             # the small rim: the rings stop short of it, the band between is
@@ -847,11 +853,10 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
             low = cand[s.on_feature[cand] & (np.abs(along[cand] - bottom) < tol * 10)]
             if low.size < 3:
                 continue
-            low_ang = np.sort(np.arctan2(dot(q[low], ey), dot(q[low], ex)) % (2 * math.pi))
-            inner = (bottom / math.cos(abs(cone.SemiAngle())), low_ang)
+            inner = (bottom / cos_a, angles(low))
         rows = steps(slant, h)
         t = slant / rows
-        rim_ang = np.sort(np.arctan2(dot(q[rim], ey), dot(q[rim], ex)) % (2 * math.pi))
+        rim_ang = angles(rim)
         ang = rim_ang
         rho_l, ang_l, row_l = [], [], []
         # rings halving by design from the rim to the apex's last rows (one
@@ -910,7 +915,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
                 )
                 got = wide if wide[4] < got[4] else got
             rho_a, ang_a, row_a, bad, worst = got
-        z = rho_a * math.cos(abs(cone.SemiAngle()))
+        z = rho_a * cos_a
         rr = rho_a * sin_a
         new = (
             apex

@@ -682,23 +682,22 @@ def _detaching(prob: _Problem, state: np.ndarray, edges, n: int, reach: int = 2)
     _, part = csgraph.connected_components(gs, directed=False)
     faces = np.flatnonzero(sel)
     of_face = piece[faces]
-    first: dict[int, int] = {}
-    for c, p in zip(faces.tolist(), of_face.tolist()):
-        first.setdefault(p, c)
     size = np.bincount(of_face)
-    keep: dict[int, int] = {}
-    for p, c in first.items():
-        q = int(part[prob.cycle_vertices[c][0]])
-        best = keep.get(q)
-        if best is None or (size[p], -first[p]) > (size[best], -first[best]):
-            keep[q] = p
+    # every piece's lowest cycle (faces ascend), and the graph piece it lies on
+    pieces, at = np.unique(of_face, return_index=True)
+    first = faces[at]
+    on = part[[int(prob.cycle_vertices[c][0]) for c in first.tolist()]]
+    # on each graph piece the largest piece of surface, then the lowest cycle, stays
+    order = np.lexsort((first, -size[pieces], on))
+    lead = np.r_[True, on[order][1:] != on[order][:-1]]
+    keep = pieces[order[lead]]
     # only closed pieces (every edge of theirs used twice) are detached: a
     # piece with a boundary is a part the rest of the selection completes
     use = np.bincount(prob.inc_edge[inc], minlength=edges.shape[0])
     open_piece = np.zeros(size.shape[0], dtype=bool)
     at_open = inc & (use[prob.inc_edge] != 2)
     open_piece[piece[prob.inc_cycle[at_open]]] = True
-    lost = faces[~np.isin(of_face, list(keep.values())) & ~open_piece[of_face]]
+    lost = faces[~np.isin(of_face, keep) & ~open_piece[of_face]]
     if lost.size == 0:
         return np.empty(0, dtype=np.int64)
     near = np.zeros(n, dtype=bool)

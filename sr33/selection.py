@@ -307,13 +307,15 @@ def _connect(m, tab, state, cycles, cyc_set, x) -> None:
 
 
 def _solve_component(
-    tab, state, cycles, conflicts, lone, seconds, max_rounds, links, allow_open, chi
+    tab, state, cycles, conflicts, lone, seconds, max_rounds, links, allow_open, chi, outside
 ):
     """One CP-SAT model over ``cycles``, lazy rounds until valid.
 
     ``links`` are the samples whose link circuit is added up front; it is
-    extended with the samples cut lazily.  Returns (new state or None,
-    proven, cuts, the budget spent in seconds).
+    extended with the samples cut lazily.  ``outside``: a selected cycle
+    outside ``cycles`` shares an edge with them (:func:`_touches_outside`,
+    the same for every model of one component: only its cycles change).
+    Returns (new state or None, proven, cuts, the budget spent in seconds).
     """
     from ortools.sat.python import cp_model
 
@@ -451,7 +453,6 @@ def _solve_component(
         add_link(v)
     # a component next to faces outside it must reach them; one that touches
     # none (a separate object) keeps its largest piece
-    outside = _touches_outside(tab, state, cycles)
     if outside:
         _connect(m, tab, state, cycles, cyc_set, x)
     elif not allow_open:
@@ -579,7 +580,8 @@ def exact_selection(
         # a selection given with a detached bubble is beaten by any valid
         # answer (they have none): its extra spheres raise the Euler
         # characteristic the comparison would otherwise prefer
-        bubbled = bool(_bubbles(tab, state, comp, _touches_outside(tab, state, comp)))
+        outside = _touches_outside(tab, state, comp)
+        bubbled = bool(_bubbles(tab, state, comp, outside))
         for allow_open in (False, True):
             # coverage first (fast, proven on the library shapes), then the
             # Euler characteristic from that answer: no handle bought with
@@ -593,7 +595,17 @@ def exact_selection(
             budget = seconds
             for chi in (False, True) if not allow_open else (False,):
                 new, p, cut, spent = _solve_component(
-                    tab, hint, comp, conflicts, lone, budget, max_rounds, links, allow_open, chi
+                    tab,
+                    hint,
+                    comp,
+                    conflicts,
+                    lone,
+                    budget,
+                    max_rounds,
+                    links,
+                    allow_open,
+                    chi,
+                    outside,
                 )
                 cuts += cut
                 budget = min(seconds, max(spent, 0.25 * seconds))

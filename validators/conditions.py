@@ -524,10 +524,10 @@ class _LocalResolution:
     nearest-neighbour distance keeps its cell resolved, elsewhere nothing
     changes."""
 
-    def __init__(self, pts: np.ndarray, resolution: float):
-        self.tree = cKDTree(pts)
-        nn = self.tree.query(pts, 2)[0][:, 1]
-        self.limit = np.clip(nn / 3.0, resolution / CROWDED_FINER, resolution)
+    def __init__(self, tree: cKDTree, nearest: np.ndarray, resolution: float):
+        # ``tree`` of the samples, ``nearest`` each one's nearest-neighbour distance
+        self.tree = tree
+        self.limit = np.clip(nearest / 3.0, resolution / CROWDED_FINER, resolution)
         self.floor = float(self.limit.min())
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
@@ -747,7 +747,8 @@ def sample_conditions(
         raise ValueError("truth: the conditions need a triangle mesh, got no triangles")
     from .fidelity import distance_to_surface
 
-    nn, _ = cKDTree(pts).query(pts, 2)
+    tree = cKDTree(pts)
+    nn, _ = tree.query(pts, 2)
     spacing = float(np.median(nn[:, 1]))
     if not spacing > 0:
         raise ValueError("points: more than half of the samples are duplicates (spacing 0)")
@@ -764,7 +765,8 @@ def sample_conditions(
         raise ValueError(f"resolution must be a positive length, got {resolution}")
     genus = tuple(c.genus for c in signature(of, ov.shape[0]).components)
     with timed("conditions: truth refined"):
-        tv, tf = refine_to_edge_length(ov, of, resolution, local=_LocalResolution(pts, resolution))
+        local = _LocalResolution(tree, nn[:, 1], resolution)
+        tv, tf = refine_to_edge_length(ov, of, resolution, local=local)
         tv, tf, snap = insert_points(tv, tf, pts)
     with timed("conditions: labels"):
         dt_edges, crossings, dt_tri = _labelled_delaunay(tv, tf, snap, pts, sharp_degrees)
