@@ -196,6 +196,80 @@ def _dividing_step(extent: float, h: float) -> float:
     return extent / steps(extent, h) if extent > 0 else h
 
 
+def _parallel_edge_offsets(face, d: np.ndarray, tol: float) -> list[float]:
+    """Offsets along ``d`` of a planar face's straight edges that lie in a
+    plane normal to ``d`` (edges parallel to the face's rows)."""
+    if face.geomType() != "PLANE":
+        return []
+    out = []
+    for e in face.Edges():
+        if e.geomType() != "LINE":
+            continue
+        a = np.array(e.startPoint().toTuple())
+        b = np.array(e.endPoint().toTuple())
+        t = b - a
+        if norm(t) > tol and abs(float(dot(t, d))) <= 1e-9 * norm(t):
+            out.append(float(dot(a, d)))
+    return out
+
+
+def _on_lattice(offsets: np.ndarray, t0: float, hf: float) -> bool:
+    """Whether every offset lies on a plane ``t0 + j hf`` (to 1e-6 of a step)."""
+    q = (offsets - t0) / hf
+    return bool(np.all(np.abs(q - np.round(q)) <= 1e-6))
+
+
+def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float) -> list[tuple[float, float]]:
+    """First plane and spacing of every face's scan planes.
+
+    A family (the faces cut by one direction ``d``) shares one lattice of
+    planes ``t0 + j hf``, so that rows go on across the edges between its
+    faces.  By default the spacing divides the shape's extent along ``d``
+    (the last plane meets the far side as the first meets the near side).
+    A straight edge parallel to the rows (in a plane normal to ``d``) must
+    lie on a plane too: there the face's rows run along the sampled edge,
+    and a plane falling just inside it is dropped (``FEATURE_CLEARANCE``),
+    leaving a gap of almost two steps (a hexagonal prism's side faces: the
+    rows 1.73 h from the vertical edges, rectangles of ratio 0.862).  Such
+    edges' offsets then anchor the lattice: ``t0`` at the least, ``hf``
+    dividing the span of them all when their gaps are whole multiples of
+    it (to 1e-6 of a step), else each face with such edges takes its own
+    lattice, anchored on its least and dividing its own span.  A family
+    whose edges already lie on the default lattice (boxes, models measured
+    in round numbers) keeps it unchanged.
+    """
+    out: list[tuple[float, float]] = []
+    lattice: dict[int, tuple[float, float]] = {}
+    offsets = [_parallel_edge_offsets(f, dirs[fam[i]], tol) for i, f in enumerate(faces)]
+    for k in sorted(set(fam)):
+        d = dirs[k]
+        proj = dot(corner, d)
+        t0 = float(proj.min())
+        hf = _dividing_step(float(proj.max()) - t0, h)
+        mine = [i for i in range(len(faces)) if fam[i] == k]
+        off = np.array(sorted(o for i in mine for o in offsets[i]))
+        if off.size == 0 or _on_lattice(off, t0, hf):
+            lattice[k] = (t0, hf)
+            continue
+        span = float(off[-1] - off[0])
+        if span > tol:
+            hs = _dividing_step(span, h)
+            if _on_lattice(off, float(off[0]), hs):
+                lattice[k] = (float(off[0]), hs)
+                continue
+        else:
+            lattice[k] = (float(off[0]), hf)
+            continue
+        lattice[k] = (t0, hf)
+        for i in mine:
+            own = np.array(sorted(offsets[i]))
+            if own.size and not _on_lattice(own, t0, hf):
+                lattice[(k, i)] = (float(own[0]), _dividing_step(float(own[-1] - own[0]), h))
+    for i in range(len(faces)):
+        out.append(lattice.get((fam[i], i), lattice[fam[i]]))
+    return out
+
+
 def _face_family(face, dirs: np.ndarray, tol: float) -> int:
     """The direction that cuts the face most transversally (area-weighted |n·d|)."""
     verts, tris = face.tessellate(tol, 0.3)
@@ -777,12 +851,10 @@ def scan(
         # rows along a coordinate axis: r times that axis's plane spacing
         axis_steps = ratio * np.array([_dividing_step(float(e), h) for e in hi - lo])
         planes = []  # per face: its family's direction, first plane, spacing, columns
+        aligned = _aligned_planes(faces, fam, dirs, corner, h, tol)
         for fi, face in enumerate(faces):
             d = dirs[fam[fi]]
-            t0 = float((dot(corner, d)).min())
-            # the family's spacing divides the shape's extent along d, so the
-            # last plane meets the far side as the first meets the near side
-            hf = _dividing_step(float((dot(corner, d)).max()) - t0, h)
+            t0, hf = aligned[fi]
             planes.append((d, t0, hf, _columns(face, d, hf, ratio, lo, axis_steps)))
         with timed("sample: feature samples"):
             pts, fids, feature_curve, lattices = _feature_samples(

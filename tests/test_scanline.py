@@ -145,3 +145,48 @@ def test_even_ends_split_a_wide_end_gap():
     kept = np.arange(1.0, 9.5, 1.0)
     np.testing.assert_allclose(_even_ends(kept, 10.0, 0.75), kept)
     assert _even_ends(np.array([0.2, 9.9]), 10.0, 0.75).size == 0
+
+
+def _hexagonal_prism():
+    ring = [(0.5 * np.cos(a), 0.5 * np.sin(a)) for a in np.linspace(0, 2 * np.pi, 7)[:-1]]
+    return cq.Workplane().polyline(ring).close().extrude(0.5).translate((0, 0, -0.25)).val()
+
+
+def test_rows_parallel_to_an_edge_start_on_it():
+    # the hexagon's two faces normal to y are cut by planes normal to x, so
+    # their vertical edges (x = +-0.25) lie in the rows' planes; the planes
+    # dividing the bounding box (x from -0.5) miss them by a quarter step,
+    # and the plane just inside each edge was dropped (1.73 h gap)
+    from sr33.samplers.scanline import AXES, _aligned_planes, _box_corners, _face_family
+
+    dirs = np.array(AXES)
+    solid = _hexagonal_prism()
+    faces = solid.Faces()
+    h = 0.5 / 16.4
+    fam = [_face_family(f, dirs, 0.005) for f in faces]
+    lo = np.array([-0.5, -np.sqrt(3) / 4, -0.25])
+    planes = _aligned_planes(faces, fam, dirs, _box_corners(lo, -lo), h, 1e-7)
+    sides = [i for i, f in enumerate(faces) if abs(f.normalAt().y) > 0.999]
+    assert len(sides) == 2
+    for i in sides:
+        assert fam[i] == 0  # planes normal to x
+        t0, hf = planes[i]
+        q = (np.array([-0.25, 0.25]) - t0) / hf
+        np.testing.assert_allclose(q, np.round(q), atol=1e-9)
+        assert 0.9 * h < hf < 1.1 * h
+    # the default lattice misses those edges: that is what is being mended
+    t0, hf = -0.5, 1.0 / round(1.0 / h)
+    q = (0.25 - t0) / hf
+    assert abs(q - round(q)) > 0.1
+
+
+@pytest.mark.slow
+def test_a_hexagonal_prism_meets_condition_iii():
+    from sr33.samplers import shapes
+    from sr33.validators.conditions import sample_conditions
+
+    s = shapes.from_cad(_hexagonal_prism())
+    r = scan(s, target_points=3000)
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    assert np.nanmax(rep.worst_ratio) <= 0.85  # 0.840 (1.000 on rows of the bounding box)
+    assert not np.isnan(rep.worst_ratio).any()
