@@ -219,8 +219,9 @@ def _on_lattice(offsets: np.ndarray, t0: float, hf: float) -> bool:
     return bool(np.all(np.abs(q - np.round(q)) <= 1e-6))
 
 
-def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float) -> list[tuple[float, float]]:
-    """First plane and spacing of every face's scan planes.
+def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float):
+    """First plane and spacing of every face's scan planes, and of every
+    family's shared lattice (direction index -> (t0, hf)).
 
     A family (the faces cut by one direction ``d``) shares one lattice of
     planes ``t0 + j hf``, so that rows go on across the edges between its
@@ -267,7 +268,7 @@ def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float) -> list[tupl
                 lattice[(k, i)] = (float(own[0]), _dividing_step(float(own[-1] - own[0]), h))
     for i in range(len(faces)):
         out.append(lattice.get((fam[i], i), lattice[fam[i]]))
-    return out
+    return out, {k: v for k, v in lattice.items() if not isinstance(k, tuple)}
 
 
 def _face_family(face, dirs: np.ndarray, tol: float) -> int:
@@ -851,11 +852,20 @@ def scan(
         # rows along a coordinate axis: r times that axis's plane spacing
         axis_steps = ratio * np.array([_dividing_step(float(e), h) for e in hi - lo])
         planes = []  # per face: its family's direction, first plane, spacing, columns
-        aligned = _aligned_planes(faces, fam, dirs, corner, h, tol)
+        aligned, family = _aligned_planes(faces, fam, dirs, corner, h, tol)
+        # a row along a coordinate axis is sampled where the planes across
+        # that axis cut it (ratio times their spacing, from their first), so
+        # that its samples meet the rows of the faces those planes cut
+        anchor = lo.copy()
+        for k, (t0, hf) in family.items():
+            a = _axis_index(dirs[k])
+            if a is not None and dirs[k][a] > 0:
+                anchor[a] = t0
+                axis_steps[a] = ratio * hf
         for fi, face in enumerate(faces):
             d = dirs[fam[fi]]
             t0, hf = aligned[fi]
-            planes.append((d, t0, hf, _columns(face, d, hf, ratio, lo, axis_steps)))
+            planes.append((d, t0, hf, _columns(face, d, hf, ratio, anchor, axis_steps)))
         with timed("sample: feature samples"):
             pts, fids, feature_curve, lattices = _feature_samples(
                 occ, EDGE_STEP * h, sharp_degrees, tol, planes
@@ -880,7 +890,7 @@ def scan(
                         chain,
                         closed,
                         ratio * hf,
-                        lo,
+                        anchor,
                         axis_steps,
                         lattices.get(fi, ()),
                         ratio,

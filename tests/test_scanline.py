@@ -147,8 +147,8 @@ def test_even_ends_split_a_wide_end_gap():
     assert _even_ends(np.array([0.2, 9.9]), 10.0, 0.75).size == 0
 
 
-def _hexagonal_prism():
-    ring = [(0.5 * np.cos(a), 0.5 * np.sin(a)) for a in np.linspace(0, 2 * np.pi, 7)[:-1]]
+def _regular_prism(sides: int = 6):
+    ring = [(0.5 * np.cos(a), 0.5 * np.sin(a)) for a in np.linspace(0, 2 * np.pi, sides + 1)[:-1]]
     return cq.Workplane().polyline(ring).close().extrude(0.5).translate((0, 0, -0.25)).val()
 
 
@@ -160,12 +160,12 @@ def test_rows_parallel_to_an_edge_start_on_it():
     from sr33.samplers.scanline import AXES, _aligned_planes, _box_corners, _face_family
 
     dirs = np.array(AXES)
-    solid = _hexagonal_prism()
+    solid = _regular_prism(6)
     faces = solid.Faces()
     h = 0.5 / 16.4
     fam = [_face_family(f, dirs, 0.005) for f in faces]
     lo = np.array([-0.5, -np.sqrt(3) / 4, -0.25])
-    planes = _aligned_planes(faces, fam, dirs, _box_corners(lo, -lo), h, 1e-7)
+    planes, _ = _aligned_planes(faces, fam, dirs, _box_corners(lo, -lo), h, 1e-7)
     sides = [i for i, f in enumerate(faces) if abs(f.normalAt().y) > 0.999]
     assert len(sides) == 2
     for i in sides:
@@ -181,12 +181,17 @@ def test_rows_parallel_to_an_edge_start_on_it():
 
 
 @pytest.mark.slow
-def test_a_hexagonal_prism_meets_condition_iii():
+@pytest.mark.parametrize("sides", [6, 7])
+def test_regular_prisms_meet_condition_iii(sides):
+    # rows parallel to a side's edges start on them, and rows along an axis
+    # are sampled where the planes across it (moved onto those edges) cut
+    # them.  Measured 0.827 (6 sides) and 0.828 (7); before: 1.000 on 10.5 %
+    # and 2.2 % of the samples
     from sr33.samplers import shapes
     from sr33.validators.conditions import sample_conditions
 
-    s = shapes.from_cad(_hexagonal_prism())
+    s = shapes.from_cad(_regular_prism(sides))
     r = scan(s, target_points=3000)
     rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
-    assert np.nanmax(rep.worst_ratio) <= 0.85  # 0.840 (1.000 on rows of the bounding box)
     assert not np.isnan(rep.worst_ratio).any()
+    assert np.max(rep.worst_ratio) <= 0.85
