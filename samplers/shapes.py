@@ -339,6 +339,12 @@ def _make_star_prism(p):
     return _prism(pts, p["height"])
 
 
+def _make_hexagonal_prism(p):
+    r = p["radius"]
+    pts = [(r * math.cos(k * math.pi / 3), r * math.sin(k * math.pi / 3)) for k in range(6)]
+    return _prism(pts, p["height"])
+
+
 def _make_fillet_box(p):
     import cadquery as cq
 
@@ -471,6 +477,10 @@ def _check_star_prism(p):
     _less(p, "inner_radius", p["outer_radius"], "outer_radius")
 
 
+def _check_hexagonal_prism(p):
+    _positive(p, "radius", "height")
+
+
 def _check_fillet_box(p):
     _positive(p, "length", "width", "height", "fillet_radius")
     smallest = min(p["length"], p["width"], p["height"])
@@ -581,6 +591,13 @@ _SPECS: dict[str, _Spec] = {
         {"outer_radius": 0.6, "inner_radius": 0.25, "height": 0.3},
         _check_star_prism,
         _make_star_prism,
+    ),
+    "hexagonal_prism": _Spec(
+        "regular hexagon (corners at the given radius, two on the x axis) extruded "
+        "along z: 120-degree side edges, two side faces parallel to the x axis",
+        {"radius": 0.5, "height": 0.5},
+        _check_hexagonal_prism,
+        _make_hexagonal_prism,
     ),
     "fillet_box": _Spec(
         "box with its vertical and top edges filleted: smooth blends ending on sharp bottom "

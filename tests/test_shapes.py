@@ -35,6 +35,7 @@ TRUTH = {
     "cutcube": (1, 0, 1, 0, True),
     "cylinder": (1, 2, 0, 0, True),
     "fillet_box": (1, 2, 0, 0, True),
+    "hexagonal_prism": (1, 2, 0, 0, True),
     "pyramid": (1, 2, 0, 0, True),
     "sphere": (1, 2, 0, 0, True),
     "square_ring": (1, 0, 1, 0, True),
