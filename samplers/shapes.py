@@ -638,7 +638,7 @@ def shape_names() -> list[str]:
     --------
     >>> names = shape_names()
     >>> len(names), names[:3]
-    (16, ['block_two_holes', 'box_hole', 'cone'])
+    (17, ['block_two_holes', 'box_hole', 'cone'])
     """
     return sorted(_SPECS, key=str.lower)
 
