@@ -219,6 +219,21 @@ def _on_lattice(offsets: np.ndarray, t0: float, hf: float) -> bool:
     return bool(np.all(np.abs(q - np.round(q)) <= 1e-6))
 
 
+def _anchored(off: np.ndarray, t0: float, hf: float, h: float, tol: float):
+    """A lattice of planes (first, spacing) holding every offset in ``off``
+    (sorted): the default ``(t0, hf)`` when it does; else anchored on the
+    least offset, its spacing the one nearest ``h`` dividing their span (the
+    default spacing when they coincide within ``tol``); None when no such
+    lattice holds them all."""
+    if off.size == 0 or _on_lattice(off, t0, hf):
+        return t0, hf
+    span = float(off[-1] - off[0])
+    if span <= tol:
+        return float(off[0]), hf
+    hs = _dividing_step(span, h)
+    return (float(off[0]), hs) if _on_lattice(off, float(off[0]), hs) else None
+
+
 def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float):
     """First plane and spacing of every face's scan planes, and of every
     family's shared lattice (direction index -> (t0, hf)).
@@ -235,37 +250,32 @@ def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float):
     edges' offsets then anchor the lattice: ``t0`` at the least, ``hf``
     dividing the span of them all when their gaps are whole multiples of
     it (to 1e-6 of a step), else each face with such edges takes its own
-    lattice, anchored on its least and dividing its own span.  A family
-    whose edges already lie on the default lattice (boxes, models measured
-    in round numbers) keeps it unchanged.
+    lattice, anchored on its least and dividing its own span
+    (:func:`_anchored`; edges at one offset keep the default spacing).  A
+    family whose edges already lie on the default lattice (boxes, models
+    measured in round numbers) keeps it unchanged.
     """
     out: list[tuple[float, float]] = []
-    lattice: dict[int, tuple[float, float]] = {}
+    lattice: dict = {}
     offsets = [_parallel_edge_offsets(f, dirs[fam[i]], tol) for i, f in enumerate(faces)]
     for k in sorted(set(fam)):
-        d = dirs[k]
-        proj = dot(corner, d)
+        proj = dot(corner, dirs[k])
         t0 = float(proj.min())
         hf = _dividing_step(float(proj.max()) - t0, h)
         mine = [i for i in range(len(faces)) if fam[i] == k]
-        off = np.array(sorted(o for i in mine for o in offsets[i]))
-        if off.size == 0 or _on_lattice(off, t0, hf):
-            lattice[k] = (t0, hf)
+        shared = _anchored(np.array(sorted(o for i in mine for o in offsets[i])), t0, hf, h, tol)
+        lattice[k] = shared or (t0, hf)
+        if shared is not None:
             continue
-        span = float(off[-1] - off[0])
-        if span > tol:
-            hs = _dividing_step(span, h)
-            if _on_lattice(off, float(off[0]), hs):
-                lattice[k] = (float(off[0]), hs)
-                continue
-        else:
-            lattice[k] = (float(off[0]), hf)
-            continue
-        lattice[k] = (t0, hf)
+        # no lattice holds every such edge of the family: each face with
+        # such edges off the default lattice takes its own
         for i in mine:
             own = np.array(sorted(offsets[i]))
             if own.size and not _on_lattice(own, t0, hf):
-                lattice[(k, i)] = (float(own[0]), _dividing_step(float(own[-1] - own[0]), h))
+                lattice[(k, i)] = _anchored(own, t0, hf, h, tol) or (
+                    float(own[0]),
+                    _dividing_step(float(own[-1] - own[0]), h),
+                )
     for i in range(len(faces)):
         out.append(lattice.get((fam[i], i), lattice[fam[i]]))
     return out, {k: v for k, v in lattice.items() if not isinstance(k, tuple)}
@@ -856,6 +866,7 @@ def scan(
         # a row along a coordinate axis is sampled where the planes across
         # that axis cut it (ratio times their spacing, from their first), so
         # that its samples meet the rows of the faces those planes cut
+        # (a direction along a negative axis keeps the box's corner and step)
         anchor = lo.copy()
         for k, (t0, hf) in family.items():
             a = _axis_index(dirs[k])
