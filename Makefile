@@ -59,9 +59,10 @@ lock: $(STAMP)
 	mv constraints.new constraints.txt
 
 # the deep profile of the fuzz targets (file readers over mutated bytes,
-# messy point arrays; over 10,000 inputs) and of the properties; one file
-# alone: make fuzz FUZZ=tests/test_fuzz.py
-FUZZ ?= tests/test_fuzz.py tests/test_properties.py
+# messy point arrays; over 10,000 inputs) and of the properties, the
+# generated-model property at GENERATED_PER_CLASS (125) models per feature
+# class (1,000 models: hours); one file alone: make fuzz FUZZ=tests/test_fuzz.py
+FUZZ ?= tests/test_fuzz.py tests/test_properties.py tests/test_generated.py
 fuzz: $(STAMP)
 	HYPOTHESIS_PROFILE=deep FUZZ_REPORT=1 $(BIN)/python -m pytest -q -p no:cacheprovider $(FUZZ)
 

@@ -67,9 +67,12 @@ def check_homeomorphism(shape, points: np.ndarray, spacing: float, rec) -> None:
     verdict = homeomorphic(sig, truth)
     assert verdict, verdict.reasons
     st_ = mesh_stats(rec.triangles, rec.vertices.shape[0])
-    assert st_.overloaded_edges == 0
-    assert st_.used_vertices == points.shape[0]
-    assert self_intersections(rec.vertices, rec.triangles).shape[0] == 0
+    assert st_.overloaded_edges == 0, f"{st_.overloaded_edges} overloaded edges"
+    assert st_.used_vertices == points.shape[0], (
+        f"{st_.used_vertices} of {points.shape[0]} samples used"
+    )
+    crossing = self_intersections(rec.vertices, rec.triangles).shape[0]
+    assert crossing == 0, f"{crossing} crossing triangle pairs"
     fid = hausdorff(
         rec.vertices, rec.triangles, shape.truth_vertices, shape.truth_triangles, samples=2000
     )
