@@ -39,19 +39,29 @@ GENERATED_PER_CLASS = int(os.environ.get("GENERATED_PER_CLASS", "125"))
 TARGET_POINTS = 3000
 
 
-def conformance(shape, points: np.ndarray) -> str | None:
+def conformance(shape, points: np.ndarray, face_id: np.ndarray | None = None) -> str | None:
     """Why ``points`` do not meet the sample conditions on ``shape``'s truth
     (None when they do): Condition III-i (DT_M degree at most 33) and III-ii
     (every DT_M triangle's ratio below √3/2), measured geodesically; a
-    sample in no DT_M triangle (the check cannot judge it) is not conforming."""
+    sample in no DT_M triangle (the check cannot judge it) is not conforming.
+    With the samples' B-rep faces (``face_id``), the reason names the kinds
+    of face the offending samples lie on (what the sampler must mend)."""
     rep = sample_conditions(points, shape.truth_vertices, shape.truth_triangles)
-    if np.isnan(rep.worst_ratio).any():
-        return "III-ii not measurable (a sample in no DT_M triangle)"
-    if int(rep.degree.max()) > 33:
-        return "III-i (degree above 33)"
-    if float(rep.worst_ratio.max()) >= rep.ratio_limit:
-        return "III-ii (a DT_M triangle at or above √3/2)"
-    return None
+    bad = np.isnan(rep.worst_ratio)
+    if bad.any():
+        why = "III-ii not measurable (a sample in no DT_M triangle)"
+    elif int(rep.degree.max()) > 33:
+        why, bad = "III-i (degree above 33)", rep.degree > 33
+    elif float(rep.worst_ratio.max()) >= rep.ratio_limit:
+        why, bad = "III-ii (a DT_M triangle at or above √3/2)", rep.worst_ratio >= rep.ratio_limit
+    else:
+        return None
+    if face_id is not None:
+        faces = shape.solid.Faces()
+        kinds = [faces[int(f)].geomType().lower() for f in face_id[bad] if f >= 0]
+        counts = {k: kinds.count(k) for k in sorted(set(kinds))}
+        why += " on " + ", ".join(f"{k} ({n} samples)" for k, n in counts.items()) if kinds else ""
+    return why
 
 
 def guarantee(model, points: np.ndarray, spacing: float, rec) -> None:
@@ -72,7 +82,7 @@ def test_conforming_samplings_of_generated_models_reconstruct_homeomorphic(featu
     model = data.draw(cad_models(feature), label="model")
     fuzzstats.count(f"generated model ({feature})")
     r = scan(model.shape, target_points=TARGET_POINTS)
-    why = conformance(model.shape, r.points)
+    why = conformance(model.shape, r.points, r.face_id)
     if why is not None:
         # not the theorem's input: counted with its reason, not a counterexample
         fuzzstats.reject(f"generated model ({feature}) not conforming: {why}")
