@@ -39,13 +39,26 @@ GENERATED_PER_CLASS = int(os.environ.get("GENERATED_PER_CLASS", "125"))
 TARGET_POINTS = 3000
 
 
-def conformance(shape, points: np.ndarray, face_id: np.ndarray | None = None) -> str | None:
+def conformance(
+    shape, points: np.ndarray, face_id: np.ndarray | None = None, spacing: float | None = None
+) -> str | None:
     """Why ``points`` do not meet the sample conditions on ``shape``'s truth
     (None when they do): Condition III-i (DT_M degree at most 33) and III-ii
     (every DT_M triangle's ratio below √3/2), measured geodesically; a
-    sample in no DT_M triangle (the check cannot judge it) is not conforming.
+    sample in no DT_M triangle (the check cannot judge it) is not conforming,
+    nor are samples closer than h/4 (``spacing``; the sampler's contract,
+    which the deep profile found broken: two samples 0 apart on a cone
+    fused with a box, which the geodesic check cannot place).
     With the samples' B-rep faces (``face_id``), the reason names the kinds
     of face the offending samples lie on (what the sampler must mend)."""
+    from scipy.spatial import cKDTree
+
+    d, _ = cKDTree(points).query(points, 2)
+    if spacing is not None and float(d[:, 1].min()) < 0.25 * spacing:
+        # the sampler's own contract (closest pair at least h/4): a duplicate
+        # or near-duplicate sample is the sampler's defect, and the geodesic
+        # check cannot place two samples on one truth vertex
+        return f"samples closer than h/4 ({float(d[:, 1].min()) / spacing:.3g} h: the sampler)"
     rep = sample_conditions(points, shape.truth_vertices, shape.truth_triangles)
     bad = np.isnan(rep.worst_ratio)
     if bad.any():
@@ -82,7 +95,7 @@ def test_conforming_samplings_of_generated_models_reconstruct_homeomorphic(featu
     model = data.draw(cad_models(feature), label="model")
     fuzzstats.count(f"generated model ({feature})")
     r = scan(model.shape, target_points=TARGET_POINTS)
-    why = conformance(model.shape, r.points, r.face_id)
+    why = conformance(model.shape, r.points, r.face_id, r.meta["spacing"])
     if why is not None:
         # not the theorem's input: counted with its reason, not a counterexample
         fuzzstats.reject(f"generated model ({feature}) not conforming: {why}")
@@ -129,3 +142,19 @@ def test_the_generated_property_fails_on_a_broken_reconstruction():
     collapsed = np.where(t[keep] == a, b, t[keep])
     with pytest.raises(AssertionError, match="samples used"):
         guarantee(Model, r.points, h, broken(triangles=collapsed))
+
+
+def test_a_sampling_with_a_duplicate_sample_does_not_conform():
+    """The deep profile drew a model whose sampling held two samples 0 apart
+    (the sampler's defect): not conforming, with the reason, instead of the
+    geodesic check's error ending the property."""
+    import cadquery as cq
+
+    from sr33.samplers import shapes
+
+    shape = shapes.from_cad(cq.Workplane().box(1.0, 0.8, 0.6).val())
+    r = scan(shape, target_points=1500)
+    h = r.meta["spacing"]
+    assert conformance(shape, r.points, r.face_id, h) is None
+    twice = np.vstack([r.points, r.points[:1]])
+    assert conformance(shape, twice, None, h) == "samples closer than h/4 (0 h: the sampler)"
