@@ -34,8 +34,8 @@ from tests.strategies import FEATURE_CLASSES, cad_models  # noqa: E402
 
 DEEP = os.environ.get("HYPOTHESIS_PROFILE") == "deep"
 GENERATED_PER_CLASS = int(os.environ.get("GENERATED_PER_CLASS", "125"))
-#: samples per generated model: small enough for the ci profile, above the
-#: paper's ~2,000 for a dozen features
+#: samples per generated model: small enough for the ci profile (a model's
+#: sampling, check and reconstruction take 10-30 s)
 TARGET_POINTS = 3000
 
 
