@@ -90,6 +90,7 @@ from .frame import in_frame, model_frame
 AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 EDGE_STEP = 1.0  # spacing of corner/edge samples, times h
 FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times h
+CLOSEST = 0.25  # no two samples nearer than this, times h (the sampler's contract)
 FILL_RADIUS = 1.0  # gaps wider than this (times h) get extra samples
 SLANT_STEP = 1.45  # slanted edges are sampled where rows cross them this close (times h)
 RATIO_RANGE = (0.6, 1.7)  # inside (1/sqrt(3), sqrt(3)) = (0.577, 1.732) with margin
@@ -189,6 +190,27 @@ def _box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     return np.array(
         [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
     )
+
+
+def _distinct(points: np.ndarray, on_feature: np.ndarray, radius: float) -> np.ndarray:
+    """Indices (sorted) of the samples kept when no two may be closer than
+    ``radius`` (the sampler's contract: h/4).  Of two closer ones the later
+    goes, unless only it is an edge or corner sample; pairs are taken in
+    index order.  Layouts that lay a sample where another already stands (a
+    seam or rim laid by both its faces) would otherwise leave duplicates:
+    a generated cone fused with a box came out with two samples 0 apart."""
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(points).query_pairs(radius, output_type="ndarray")
+    if pairs.shape[0] == 0:
+        return np.arange(points.shape[0])
+    pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+    gone = np.zeros(points.shape[0], dtype=bool)
+    for i, j in pairs.tolist():
+        if gone[i] or gone[j]:
+            continue
+        gone[i if on_feature[j] and not on_feature[i] else j] = True
+    return np.flatnonzero(~gone)
 
 
 def _dividing_step(extent: float, h: float) -> float:
@@ -976,6 +998,18 @@ def scan(
                 bag.line_id,
                 bag.face_id,
                 bag.on_feature,
+            )
+        keep = _distinct(points, on_feature, CLOSEST * h)
+        if keep.shape[0] < points.shape[0]:
+            log.debug(
+                "sample: %d samples closer than h/4 to another dropped",
+                points.shape[0] - keep.shape[0],
+            )
+            points, line_id, face_id, on_feature = (
+                points[keep],
+                line_id[keep],
+                face_id[keep],
+                on_feature[keep],
             )
         rng = np.random.default_rng(seed)
         if jitter > 0:

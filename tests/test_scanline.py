@@ -195,3 +195,13 @@ def test_regular_prisms_meet_condition_iii(sides):
     rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
     assert not np.isnan(rep.worst_ratio).any()
     assert np.max(rep.worst_ratio) <= 0.85
+
+
+def test_no_two_samples_closer_than_a_quarter_step():
+    # the later of two close samples goes, unless only it lies on an edge
+    from sr33.samplers.scanline import _distinct
+
+    p = np.array([[0, 0, 0], [0.1, 0, 0], [1, 0, 0], [1, 0, 0], [2, 0, 0], [2.2, 0, 0.0]])
+    feature = np.array([False, True, False, False, True, False])
+    np.testing.assert_array_equal(_distinct(p, feature, 0.25), [1, 2, 4])
+    np.testing.assert_array_equal(_distinct(p[[0, 2, 4]], feature[[0, 2, 4]], 0.25), [0, 1, 2])
