@@ -194,22 +194,21 @@ def _box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
 
 def _distinct(points: np.ndarray, on_feature: np.ndarray, radius: float) -> np.ndarray:
     """Indices (sorted) of the samples kept when no two may be closer than
-    ``radius`` (the sampler's contract: h/4).  Of two closer ones the later
-    goes, unless only it is an edge or corner sample; pairs are taken in
-    index order.  Layouts that lay a sample where another already stands (a
-    seam or rim laid by both its faces) would otherwise leave duplicates:
-    a generated cone fused with a box came out with two samples 0 apart."""
+    ``radius`` (the sampler's contract: h/4): :func:`~.faces.thin` over the
+    samples that have such a neighbour, edge and corner samples first, each
+    group in index order.  Layouts that lay a sample where another already
+    stands (a seam or rim laid by both its faces) would otherwise leave
+    duplicates: a generated cone fused with a box came out with two samples
+    0 apart."""
     from scipy.spatial import cKDTree
 
-    pairs = cKDTree(points).query_pairs(radius, output_type="ndarray")
-    if pairs.shape[0] == 0:
+    close = np.unique(cKDTree(points).query_pairs(radius, output_type="ndarray"))
+    if close.size == 0:
         return np.arange(points.shape[0])
-    pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+    close = close[np.argsort(~on_feature[close], kind="stable")]
     gone = np.zeros(points.shape[0], dtype=bool)
-    for i, j in pairs.tolist():
-        if gone[i] or gone[j]:
-            continue
-        gone[i if on_feature[j] and not on_feature[i] else j] = True
+    gone[close] = True
+    gone[close[thin(points[close], radius)]] = False
     return np.flatnonzero(~gone)
 
 
@@ -277,8 +276,8 @@ def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float):
     family whose edges already lie on the default lattice (boxes, models
     measured in round numbers) keeps it unchanged.
     """
-    out: list[tuple[float, float]] = []
-    lattice: dict = {}
+    family: dict[int, tuple[float, float]] = {}
+    own: dict[int, tuple[float, float]] = {}  # faces on a lattice of their own
     offsets = [_parallel_edge_offsets(f, dirs[fam[i]], tol) for i, f in enumerate(faces)]
     for k in sorted(set(fam)):
         proj = dot(corner, dirs[k])
@@ -286,21 +285,19 @@ def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float):
         hf = _dividing_step(float(proj.max()) - t0, h)
         mine = [i for i in range(len(faces)) if fam[i] == k]
         shared = _anchored(np.array(sorted(o for i in mine for o in offsets[i])), t0, hf, h, tol)
-        lattice[k] = shared or (t0, hf)
+        family[k] = shared or (t0, hf)
         if shared is not None:
             continue
         # no lattice holds every such edge of the family: each face with
         # such edges off the default lattice takes its own
         for i in mine:
-            own = np.array(sorted(offsets[i]))
-            if own.size and not _on_lattice(own, t0, hf):
-                lattice[(k, i)] = _anchored(own, t0, hf, h, tol) or (
-                    float(own[0]),
-                    _dividing_step(float(own[-1] - own[0]), h),
+            off = np.array(sorted(offsets[i]))
+            if off.size and not _on_lattice(off, t0, hf):
+                own[i] = _anchored(off, t0, hf, h, tol) or (
+                    float(off[0]),
+                    _dividing_step(float(off[-1] - off[0]), h),
                 )
-    for i in range(len(faces)):
-        out.append(lattice.get((fam[i], i), lattice[fam[i]]))
-    return out, {k: v for k, v in lattice.items() if not isinstance(k, tuple)}
+    return [own.get(i, family[fam[i]]) for i in range(len(faces))], family
 
 
 def _face_family(face, dirs: np.ndarray, tol: float) -> int:

@@ -198,7 +198,7 @@ def test_regular_prisms_meet_condition_iii(sides):
 
 
 def test_no_two_samples_closer_than_a_quarter_step():
-    # the later of two close samples goes, unless only it lies on an edge
+    # of two close samples an edge sample stays, else the earlier one
     from sr33.samplers.scanline import _distinct
 
     p = np.array([[0, 0, 0], [0.1, 0, 0], [1, 0, 0], [1, 0, 0], [2, 0, 0], [2.2, 0, 0.0]])
