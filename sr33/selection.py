@@ -315,7 +315,8 @@ def _solve_component(
     extended with the samples cut lazily.  ``outside``: a selected cycle
     outside ``cycles`` shares an edge with them (:func:`_touches_outside`,
     the same for every model of one component: only its cycles change).
-    Returns (new state or None, proven, cuts, the budget spent in seconds).
+    Returns (new state or None, proven -- optimal, or with None infeasible --,
+    cuts, the budget spent in seconds).
     """
     from ortools.sat.python import cp_model
 
@@ -474,6 +475,9 @@ def _solve_component(
         budget -= solver.deterministic_time
         spent += solver.deterministic_time
         if status not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
+            # INFEASIBLE: proven that no selection meets the model (the lazy
+            # cuts only ever add constraints)
+            proven = status == cp_model.INFEASIBLE
             break
         trial = state.copy()
         for c in cycles:
@@ -611,6 +615,10 @@ def exact_selection(
                 budget = min(seconds, max(spent, 0.25 * seconds))
                 if new is not None:
                     best, prov, hint = new, p, new
+                elif p:
+                    # proven infeasible: the Euler phase has the same
+                    # constraints (cheburashka: two of five components, 0.2 s)
+                    break
             if best is None:
                 continue
             if bubbled or _score(tab, best, comp, edges_, verts_, lone).better_than(

@@ -67,3 +67,33 @@ def test_the_exact_selection_is_deterministic():
     pts, e, cyc = _octahedron_and_tent()
     runs = {backtracking(pts, e, cyc).selected.tobytes() for _ in range(3)}
     assert len(runs) == 1
+
+
+def test_a_closed_model_proven_infeasible_skips_the_euler_phase(monkeypatch):
+    """Three triangles on one edge (a book of three pages): a closed selection
+    needs every edge twice, and each page's two other edges lie in it alone, so
+    the closed model is infeasible -- proven at once.  The Euler phase has the
+    same constraints and is not run; the open phase follows and the fallback's
+    two pages stand (cheburashka: two of five components, 0.2 s)."""
+    from sr33 import selection
+
+    calls = []
+    solve = selection._solve_component
+
+    def recorded(*args):
+        out = solve(*args)
+        allow_open, chi = args[8], args[9]
+        calls.append((allow_open, chi, out[0] is not None, out[1]))
+        return out
+
+    monkeypatch.setattr(selection, "_solve_component", recorded)
+    pts = np.array(
+        [[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, -0.5, 0.8], [0.5, -0.5, -0.8]], dtype=float
+    )
+    e = _edges([(0, 1), (0, 2), (1, 2), (0, 3), (1, 3), (0, 4), (1, 4)])
+    cyc = trivial_isometric_cycles(e, len(pts))
+    assert len(cyc) == 3
+    sel = backtracking(pts, e, cyc)
+    # closed: no answer, proven; open: an answer, proven optimal
+    assert calls == [(False, False, False, True), (True, False, True, True)]
+    assert sel.success and len(sel.faces) == 2 and sel.exact.components == 1
