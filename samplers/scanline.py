@@ -200,8 +200,6 @@ def _distinct(points: np.ndarray, on_feature: np.ndarray, radius: float) -> np.n
     stands (a seam or rim laid by both its faces) would otherwise leave
     duplicates: a generated cone fused with a box came out with two samples
     0 apart."""
-    from scipy.spatial import cKDTree
-
     close = np.unique(cKDTree(points).query_pairs(radius, output_type="ndarray"))
     if close.size == 0:
         return np.arange(points.shape[0])
@@ -589,8 +587,6 @@ def _drop_near_features(points, on_line, feature_curve, radius):
     closer to the other face's samples than the edge samples are to each
     other.
     """
-    from scipy.spatial import cKDTree
-
     keep = np.ones(points.shape[0], dtype=bool)
     if feature_curve.shape[0] == 0 or not on_line.any():
         return keep
@@ -1003,10 +999,7 @@ def scan(
                 points.shape[0] - keep.shape[0],
             )
             points, line_id, face_id, on_feature = (
-                points[keep],
-                line_id[keep],
-                face_id[keep],
-                on_feature[keep],
+                a[keep] for a in (points, line_id, face_id, on_feature)
             )
         rng = np.random.default_rng(seed)
         if jitter > 0:
@@ -1014,10 +1007,7 @@ def scan(
         if dropout > 0:
             mask = rng.random(points.shape[0]) >= dropout
             points, line_id, face_id, on_feature = (
-                points[mask],
-                line_id[mask],
-                face_id[mask],
-                on_feature[mask],
+                a[mask] for a in (points, line_id, face_id, on_feature)
             )
         meta = {
             **_shape_meta(shape, occ),

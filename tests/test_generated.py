@@ -51,14 +51,15 @@ def conformance(
     fused with a box, which the geodesic check cannot place).
     With the samples' B-rep faces (``face_id``), the reason names the kinds
     of face the offending samples lie on (what the sampler must mend)."""
-    from scipy.spatial import cKDTree
+    if spacing is not None:
+        from scipy.spatial import cKDTree
 
-    d, _ = cKDTree(points).query(points, 2)
-    if spacing is not None and float(d[:, 1].min()) < 0.25 * spacing:
-        # the sampler's own contract (closest pair at least h/4): a duplicate
-        # or near-duplicate sample is the sampler's defect, and the geodesic
-        # check cannot place two samples on one truth vertex
-        return f"samples closer than h/4 ({float(d[:, 1].min()) / spacing:.3g} h: the sampler)"
+        closest = float(cKDTree(points).query(points, 2)[0][:, 1].min())
+        if closest < 0.25 * spacing:
+            # the sampler's own contract (closest pair at least h/4): a duplicate
+            # or near-duplicate sample is the sampler's defect, and the geodesic
+            # check cannot place two samples on one truth vertex
+            return f"samples closer than h/4 ({closest / spacing:.3g} h: the sampler)"
     rep = sample_conditions(points, shape.truth_vertices, shape.truth_triangles)
     bad = np.isnan(rep.worst_ratio)
     if bad.any():

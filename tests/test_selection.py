@@ -75,15 +75,18 @@ def test_a_closed_model_proven_infeasible_skips_the_euler_phase(monkeypatch):
     the closed model is infeasible -- proven at once.  The Euler phase has the
     same constraints and is not run; the open phase follows and the fallback's
     two pages stand (cheburashka: two of five components, 0.2 s)."""
+    import inspect
+
     from sr33 import selection
 
     calls = []
     solve = selection._solve_component
+    signature = inspect.signature(solve)
 
-    def recorded(*args):
-        out = solve(*args)
-        allow_open, chi = args[8], args[9]
-        calls.append((allow_open, chi, out[0] is not None, out[1]))
+    def recorded(*args, **kwargs):
+        out = solve(*args, **kwargs)
+        given = signature.bind(*args, **kwargs).arguments
+        calls.append((given["allow_open"], given["chi"], out[0] is not None, out[1]))
         return out
 
     monkeypatch.setattr(selection, "_solve_component", recorded)
