@@ -460,13 +460,14 @@ def test_revolved_body_is_laid_out_in_rings():
     assert d.max() < 2e-3 * r.meta["spacing"] * 50  # on the surface, up to the truth's sagitta
 
 
+@pytest.mark.parametrize("gap", [0.75, 0.7, 0.8])
 @pytest.mark.parametrize(
     "radii, h", [((0.5,), 0.025), ((0.5,), 0.03), ((0.5, 0.3), 0.02), ((0.35, 0.05), 0.02)]
 )
-def test_ring_plan_halves_its_columns_towards_the_centre(radii, h):
-    from sr33.samplers.disks import HALVE_GAP, ring_plan
+def test_ring_plan_halves_its_columns_towards_the_centre(radii, h, gap):
+    from sr33.samplers.disks import ring_plan
 
-    t, rings = ring_plan(radii, h)
+    t, rings = ring_plan(radii, h, gap)
     r = np.array([x for x, _ in rings])
     c = np.array([n for _, n in rings])
     np.testing.assert_allclose(-np.diff(r), t)
@@ -478,11 +479,58 @@ def test_ring_plan_halves_its_columns_towards_the_centre(radii, h):
     inner = slice(None) if len(radii) > 1 else slice(None, -1)  # not the ring round a centre
     d = c[inner]
     assert np.all((d[:-1] == d[1:]) | (d[:-1] == 2 * d[1:]))
-    gap = 2 * np.pi * r / c
-    assert gap[inner].min() >= HALVE_GAP * t - 1e-12
-    assert gap[inner].max() < 1.5 * t
+    gaps = 2 * np.pi * r / c
+    assert gaps[inner].min() >= gap * t - 1e-12
+    assert gaps[inner].max() < 2 * gap * t  # a ring halves before its gap doubles it
     if len(radii) == 1:
         assert 3 <= base <= 5  # round a disk's centre: a chord longer than the sides
+
+
+def test_a_disk_layout_tries_the_next_halving_gap_until_one_meets_the_margin(monkeypatch):
+    """The repair behind a ring layout is a local search whose end depends on
+    where the rings halve: ``_layout`` tries ``HALVE_GAPS`` in turn, keeps the
+    first below ``LAYOUT_GOOD`` and otherwise the lowest (the first of equal
+    ones)."""
+    from sr33.samplers import disks
+
+    def fake(worsts):
+        seen = []
+
+        def layout_with(radii, h, gap):
+            seen.append(gap)
+            w = worsts[disks.HALVE_GAPS.index(gap)]
+            return disks._Layout(np.zeros((1, 2)), np.zeros(1, bool), np.zeros(1, int), 0, w, gap)
+
+        monkeypatch.setattr(disks, "_layout_with", layout_with)
+        return seen
+
+    seen = fake([0.90, 0.95, 0.83, 0.80, 0.80])
+    lay = disks._layout((10.0,), 1.0)
+    assert (lay.gap, lay.worst) == (disks.HALVE_GAPS[2], 0.83)
+    assert seen == list(disks.HALVE_GAPS[:3])  # it stops at the first good one
+    seen = fake([0.90, 0.86, 0.88, 0.86, 0.87])
+    lay = disks._layout((10.0,), 1.0)
+    assert (lay.gap, lay.worst) == (disks.HALVE_GAPS[1], 0.86)
+    assert seen == list(disks.HALVE_GAPS)
+    seen = fake([0.80, 0.70, 0.70, 0.70, 0.70])
+    assert disks._layout((10.0,), 1.0).gap == disks.HALVE_GAP and len(seen) == 1
+
+
+@pytest.mark.slow
+def test_disk_layouts_meet_condition_iii_at_every_radius():
+    """Every disk from 4 h to 34 h in radius (not only the library's): its
+    rings' Delaunay triangles stay below 0.85 (HALVE_GAP alone left 6 of 30
+    radii between 0.887 and 0.978)."""
+    from scipy.spatial import Delaunay
+
+    from sr33.mesh import triangle_ratios
+    from sr33.samplers.disks import _layout
+
+    for radius in np.round(np.arange(4.0, 34.0, 2.06), 3):
+        lay = _layout((float(radius),), 1.0)
+        ratio = triangle_ratios(lay.uv, Delaunay(lay.uv).simplices)
+        assert ratio.max() < 0.85, (radius, ratio.max())
+        assert ratio.max() == pytest.approx(lay.worst)
 
 
 @pytest.mark.parametrize("name", by_speed(["cone", "cylinder", "square_ring"]))
