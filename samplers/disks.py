@@ -52,6 +52,9 @@ HALVE_GAP = 0.75  # a ring halves its columns rather than let gaps fall below th
 #: 0.978: 4.0 h, 5.03 h and 18.4 h to 21.5 h), each of them below 0.84 with
 #: 0.72 (18.4 h to 22.5 h) or 0.80 (4.0 h, 5.03 h)
 HALVE_GAPS = (HALVE_GAP, 0.72, 0.80, 0.70, 0.78)
+#: ... and then again with one ring more (a disk of radius 4.5 h: 0.931 at
+#: every gap with 4 rings, 0.827 with 5 rings and the gap 0.80)
+RINGS_ADDED = (0, 1)
 LAYOUT_GOOD = 0.835
 
 
@@ -141,7 +144,7 @@ def _rim_ok(fi: int, edge, adjacency: EdgeFaces, found) -> bool:
 
 
 def ring_plan(
-    radii: tuple[float, ...], h: float, gap: float = HALVE_GAP
+    radii: tuple[float, ...], h: float, gap: float = HALVE_GAP, extra: int = 0
 ) -> tuple[float, list[tuple[float, int]]]:
     """Radial step and (radius, column count) of every ring, the rims included.
 
@@ -154,11 +157,13 @@ def ring_plan(
     gap : float
         A ring halves its columns rather than let their gaps fall below
         this (times t).
+    extra : int
+        Rings added to the ``round(W / h)`` steps (a finer radial step).
 
     Returns
     -------
     t : float
-        The radial step, ``W / round(W / h)``.
+        The radial step, ``W / (round(W / h) + extra)``.
     rings : list of (float, int)
         From the outer rim inwards; a disk's innermost ring is at ``t``
         (its centre sample is not listed).  Every count is ``c 2^L`` for
@@ -178,7 +183,7 @@ def ring_plan(
     """
     outer = radii[0]
     inner = radii[1] if len(radii) > 1 else 0.0
-    rows = steps(outer - inner, h)
+    rows = steps(outer - inner, h) + extra
     t = (outer - inner) / rows
     if inner > 0:
         base = steps(2 * math.pi * inner, h, least=3)
@@ -232,29 +237,39 @@ class _Layout:
     bad: int
     worst: float  # of the face's Delaunay triangles
     gap: float  # the halving gap of its rings (HALVE_GAPS)
+    extra: int = 0  # rings added to round(W / h) (RINGS_ADDED)
 
 
 def _layout(radii: tuple[float, ...], h: float) -> _Layout:
-    """The repaired ring samples of a face of these radii: the first of
-    ``HALVE_GAPS`` whose layout's worst Delaunay ratio is below
-    ``LAYOUT_GOOD``, else the lowest (the first of equal ones).  Where the
-    rings halve decides what the repair starts from, and a repair left stuck
-    at one halving gap is mended from another's rings more often than by
-    more attempts from the same ones (see ``HALVE_GAPS``)."""
+    """The repaired ring samples of a face of these radii: the first ring
+    plan (``HALVE_GAPS`` in turn, then the same with one ring more; a plan
+    equal to one tried before is skipped) whose layout's worst Delaunay
+    ratio is below ``LAYOUT_GOOD``, else the lowest (the first of equal
+    ones).  Where the rings halve decides what the repair starts from, and
+    a repair left stuck from one plan is mended from another's rings more
+    often than by more attempts from the same ones (see ``HALVE_GAPS``)."""
     best = None
-    for gap in HALVE_GAPS:
-        lay = _layout_with(radii, h, gap)
-        if best is None or lay.worst < best.worst:
-            best = lay
-        if lay.worst < LAYOUT_GOOD:
-            break
+    tried = set()
+    for extra in RINGS_ADDED:
+        for gap in HALVE_GAPS:
+            t, rings = ring_plan(radii, h, gap, extra)
+            plan = (round(t, 12), tuple(c for _, c in rings))
+            if plan in tried:
+                continue
+            tried.add(plan)
+            lay = _layout_with(radii, h, gap, extra)
+            if best is None or lay.worst < best.worst:
+                best = lay
+            if lay.worst < LAYOUT_GOOD:
+                return best
     return best
 
 
-def _layout_with(radii: tuple[float, ...], h: float, gap: float) -> _Layout:
-    """:func:`_layout` for one halving gap; ``worst`` is that of the face's
-    whole Delaunay triangulation (an annulus' hole left out)."""
-    t, rings = ring_plan(radii, h, gap)
+def _layout_with(radii: tuple[float, ...], h: float, gap: float, extra: int = 0) -> _Layout:
+    """:func:`_layout` for one ring plan (:func:`ring_plan`'s ``gap`` and
+    ``extra``); ``worst`` is that of the face's whole Delaunay triangulation
+    (an annulus' hole left out)."""
+    t, rings = ring_plan(radii, h, gap, extra)
     disk = len(radii) == 1
     uv, ring, near = _ring_points(t, rings, disk)
     rim = (ring == 0) | ((ring == len(rings) - 1) & (not disk))
@@ -276,7 +291,7 @@ def _layout_with(radii: tuple[float, ...], h: float, gap: float) -> _Layout:
     tri = Delaunay(uv).simplices
     tri = tri[inside(uv[tri].mean(axis=1))]
     worst = float(triangle_ratios(uv, tri).max()) if tri.size else 0.0
-    return _Layout(uv, rim, ring, bad, worst, gap)
+    return _Layout(uv, rim, ring, bad, worst, gap, extra)
 
 
 def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dict], set[int]]:
@@ -340,6 +355,7 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
                 "bad": lay.bad,
                 "worst": lay.worst,
                 "halving_gap": lay.gap,
+                "rings_added": lay.extra,
             }
         )
     return reports, done

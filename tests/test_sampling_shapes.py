@@ -486,47 +486,61 @@ def test_ring_plan_halves_its_columns_towards_the_centre(radii, h, gap):
         assert 3 <= base <= 5  # round a disk's centre: a chord longer than the sides
 
 
-def test_a_disk_layout_tries_the_next_halving_gap_until_one_meets_the_margin(monkeypatch):
+def test_a_disk_layout_tries_other_ring_plans_until_one_meets_the_margin(monkeypatch):
     """The repair behind a ring layout is a local search whose end depends on
-    where the rings halve: ``_layout`` tries ``HALVE_GAPS`` in turn, keeps the
-    first below ``LAYOUT_GOOD`` and otherwise the lowest (the first of equal
-    ones)."""
+    where the rings halve: ``_layout`` tries the ring plans of ``HALVE_GAPS``
+    and then those with ``RINGS_ADDED`` in turn, each distinct plan once, keeps
+    the first below ``LAYOUT_GOOD`` and otherwise the lowest (the first of
+    equal ones)."""
     from sr33.samplers import disks
 
-    def fake(worsts):
+    radii = (10.0,)
+    order = [(e, g) for e in disks.RINGS_ADDED for g in disks.HALVE_GAPS]
+
+    def plan(e, g):
+        t, rings = disks.ring_plan(radii, 1.0, g, e)
+        return round(t, 12), tuple(c for _, c in rings)
+
+    distinct = [k for i, k in enumerate(order) if plan(*k) not in {plan(*x) for x in order[:i]}]
+    assert len(distinct) > len(disks.RINGS_ADDED)  # the gaps do change the plan
+
+    def fake(worst_of):
         seen = []
 
-        def layout_with(radii, h, gap):
-            seen.append(gap)
-            w = worsts[disks.HALVE_GAPS.index(gap)]
-            return disks._Layout(np.zeros((1, 2)), np.zeros(1, bool), np.zeros(1, int), 0, w, gap)
+        def layout_with(radii, h, gap, extra=0):
+            seen.append((extra, gap))
+            w = worst_of(len(seen) - 1)
+            return disks._Layout(
+                np.zeros((1, 2)), np.zeros(1, bool), np.zeros(1, int), 0, w, gap, extra
+            )
 
         monkeypatch.setattr(disks, "_layout_with", layout_with)
         return seen
 
-    seen = fake([0.90, 0.95, 0.83, 0.80, 0.80])
-    lay = disks._layout((10.0,), 1.0)
-    assert (lay.gap, lay.worst) == (disks.HALVE_GAPS[2], 0.83)
-    assert seen == list(disks.HALVE_GAPS[:3])  # it stops at the first good one
-    seen = fake([0.90, 0.86, 0.88, 0.86, 0.87])
-    lay = disks._layout((10.0,), 1.0)
-    assert (lay.gap, lay.worst) == (disks.HALVE_GAPS[1], 0.86)
-    assert seen == list(disks.HALVE_GAPS)
-    seen = fake([0.80, 0.70, 0.70, 0.70, 0.70])
-    assert disks._layout((10.0,), 1.0).gap == disks.HALVE_GAP and len(seen) == 1
+    # the third plan is the first good one: it is kept and the search stops
+    seen = fake(lambda i: [0.90, 0.95, 0.83][i] if i < 3 else 0.5)
+    lay = disks._layout(radii, 1.0)
+    assert seen == distinct[:3] and (lay.extra, lay.gap, lay.worst) == (*distinct[2], 0.83)
+    # none good: every distinct plan tried, the lowest kept (the first of equal ones)
+    seen = fake(lambda i: 0.86 if i in (1, 3) else 0.9)
+    lay = disks._layout(radii, 1.0)
+    assert seen == distinct and (lay.extra, lay.gap, lay.worst) == (*distinct[1], 0.86)
+    # the first plan good: nothing else is tried
+    seen = fake(lambda i: 0.8)
+    assert disks._layout(radii, 1.0).gap == disks.HALVE_GAP and seen == [(0, disks.HALVE_GAP)]
 
 
 @pytest.mark.slow
 def test_disk_layouts_meet_condition_iii_at_every_radius():
     """Every disk from 4 h to 34 h in radius (not only the library's): its
     rings' Delaunay triangles stay below 0.85 (HALVE_GAP alone left 6 of 30
-    radii between 0.887 and 0.978)."""
+    radii between 0.887 and 0.978; 4.5 h needed a ring more)."""
     from scipy.spatial import Delaunay
 
     from sr33.mesh import triangle_ratios
     from sr33.samplers.disks import _layout
 
-    for radius in np.round(np.arange(4.0, 34.0, 2.06), 3):
+    for radius in [4.5, *np.round(np.arange(4.0, 34.0, 2.06), 3)]:
         lay = _layout((float(radius),), 1.0)
         ratio = triangle_ratios(lay.uv, Delaunay(lay.uv).simplices)
         assert ratio.max() < 0.85, (radius, ratio.max())
