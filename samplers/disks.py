@@ -21,8 +21,8 @@ row:
   slightly too regular; :func:`sr33.samplers.repair.repair` mends them, the
   rims held fixed.  That repair is a local search whose end depends on
   where it starts: the halving gap is tried at a few values in turn
-  (``HALVE_GAPS``) until the repaired layout meets Condition III-ii with a
-  margin.
+  (``HALVE_GAPS``), then with one ring more (``RINGS_ADDED``), until the
+  repaired layout meets Condition III-ii with a margin (``LAYOUT_GOOD``).
 
 The angles start from one direction per plane orientation (parallel faces,
 such as a cylinder's two caps, get the same angles), so a cylinder's two
@@ -55,6 +55,9 @@ HALVE_GAPS = (HALVE_GAP, 0.72, 0.80, 0.70, 0.78)
 #: ... and then again with one ring more (a disk of radius 4.5 h: 0.931 at
 #: every gap with 4 rings, 0.827 with 5 rings and the gap 0.80)
 RINGS_ADDED = (0, 1)
+#: a layout whose worst Delaunay ratio is below this ends the search (the
+#: margin the poles' repairs keep too); ratios are compared rounded to 1e-9,
+#: so that a last-bit difference cannot decide between two plans
 LAYOUT_GOOD = 0.835
 
 
@@ -258,9 +261,9 @@ def _layout(radii: tuple[float, ...], h: float) -> _Layout:
                 continue
             tried.add(plan)
             lay = _layout_with(radii, h, gap, extra)
-            if best is None or lay.worst < best.worst:
+            if best is None or round(lay.worst, 9) < round(best.worst, 9):
                 best = lay
-            if lay.worst < LAYOUT_GOOD:
+            if round(lay.worst, 9) < LAYOUT_GOOD:
                 return best
     return best
 
