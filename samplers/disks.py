@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay
 
-from sr33.mesh import dot, norm, triangle_ratios
+from sr33.mesh import dot, flipped_ratios, norm, triangle_ratios
 
 from .adjacency import EdgeFaces
 from .chart import halving_count, radial_clamp
@@ -59,6 +59,12 @@ RINGS_ADDED = (0, 1)
 #: margin the poles' repairs keep too); ratios are compared rounded to 1e-9,
 #: so that a last-bit difference cannot decide between two plans
 LAYOUT_GOOD = 0.835
+#: a cell whose opposite angles sum to within this (radians) of pi is judged
+#: with either diagonal (:func:`sr33.mesh.flipped_ratios`): a cone's disk
+#: whose Delaunay triangles were all below 0.832 had a cell 0.012 short of
+#: cocircular whose other diagonal makes a triangle of 0.988, and the
+#: geodesic check, on the tessellated truth, took that one
+COCIRCULAR = 0.05
 
 
 @dataclass(frozen=True)
@@ -239,6 +245,7 @@ class _Layout:
     ring: np.ndarray  # ring index (0 the outer rim); -1 the centre or a sample the repair added
     bad: int
     worst: float  # of the face's Delaunay triangles
+    either: float  # ... and of near-cocircular cells with their other diagonal
     gap: float  # the halving gap of its rings (HALVE_GAPS)
     extra: int = 0  # rings added to round(W / h) (RINGS_ADDED)
 
@@ -247,10 +254,12 @@ def _layout(radii: tuple[float, ...], h: float) -> _Layout:
     """The repaired ring samples of a face of these radii: the first ring
     plan (``HALVE_GAPS`` in turn, then the same with one ring more; a plan
     equal to one tried before is skipped) whose layout's worst Delaunay
-    ratio is below ``LAYOUT_GOOD``, else the lowest (the first of equal
-    ones).  Where the rings halve decides what the repair starts from, and
-    a repair left stuck from one plan is mended from another's rings more
-    often than by more attempts from the same ones (see ``HALVE_GAPS``)."""
+    ratio, near-cocircular cells judged with either diagonal, is below
+    ``LAYOUT_GOOD``; else the one with the lowest worst Delaunay ratio (then
+    the lowest with either diagonal, then the first).  Where the rings
+    halve decides what the repair starts from, and a repair left stuck
+    from one plan is mended from another's rings more often than by more
+    attempts from the same ones (see ``HALVE_GAPS``)."""
     best = None
     tried = set()
     for extra in RINGS_ADDED:
@@ -261,17 +270,19 @@ def _layout(radii: tuple[float, ...], h: float) -> _Layout:
                 continue
             tried.add(plan)
             lay = _layout_with(radii, h, gap, extra)
-            if best is None or round(lay.worst, 9) < round(best.worst, 9):
-                best = lay
-            if round(lay.worst, 9) < LAYOUT_GOOD:
-                return best
-    return best
+            rank = (round(lay.worst, 9), round(lay.either, 9))
+            if best is None or rank < best[0]:
+                best = (rank, lay)
+            if round(lay.either, 9) < LAYOUT_GOOD:
+                return lay
+    return best[1]
 
 
 def _layout_with(radii: tuple[float, ...], h: float, gap: float, extra: int = 0) -> _Layout:
     """:func:`_layout` for one ring plan (:func:`ring_plan`'s ``gap`` and
     ``extra``); ``worst`` is that of the face's whole Delaunay triangulation
-    (an annulus' hole left out)."""
+    (an annulus' hole left out), ``either`` that with near-cocircular cells
+    judged with either diagonal (``COCIRCULAR``)."""
     t, rings = ring_plan(radii, h, gap, extra)
     disk = len(radii) == 1
     uv, ring, near = _ring_points(t, rings, disk)
@@ -293,8 +304,9 @@ def _layout_with(radii: tuple[float, ...], h: float, gap: float, extra: int = 0)
         uv, bad = out.uv, int(out.bad)
     tri = Delaunay(uv).simplices
     tri = tri[inside(uv[tri].mean(axis=1))]
-    worst = float(triangle_ratios(uv, tri).max()) if tri.size else 0.0
-    return _Layout(uv, rim, ring, bad, worst, gap, extra)
+    worst = float(np.r_[triangle_ratios(uv, tri), 0.0].max())
+    either = max(worst, float(np.r_[flipped_ratios(uv, tri, COCIRCULAR), 0.0].max()))
+    return _Layout(uv, rim, ring, bad, worst, either, gap, extra)
 
 
 def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dict], set[int]]:

@@ -351,6 +351,57 @@ def triangle_ratios(points, triangles) -> np.ndarray:
         return length[:, 1] / length[:, 2]
 
 
+def flipped_ratios(points, triangles, slack: float) -> np.ndarray:
+    """Ratios (:func:`triangle_ratios`) of the triangles a near-cocircular
+    cell would have with its other diagonal.
+
+    Where two triangles ``(a, b, c)`` and ``(b, a, d)`` share an edge and
+    their angles at ``c`` and ``d`` sum to more than ``pi - slack``, the four
+    corners are within ``slack`` of one circle: the Delaunay triangulation
+    could as well take the diagonal ``c d``, and which one a triangulation
+    (or a geodesic check on a tessellated truth) takes depends on tiny
+    differences.  Condition III-ii is met with a margin only if both
+    diagonals meet it.  Returns the ratios of the triangles ``(a, c, d)``
+    and ``(b, d, c)`` of every such cell (empty when there is none).
+    Works on 2-D points (a planar chart).
+
+    Examples
+    --------
+    A unit square's two triangulations are mirror images:
+
+    >>> np.round(flipped_ratios([[0, 0], [1, 0], [1, 1], [0, 1]], [(0, 1, 2), (0, 2, 3)], 0.01), 4)
+    array([0.7071, 0.7071])
+    """
+    p = np.asarray(points, dtype=np.float64)
+    t = as_triangles(triangles)
+    if t.shape[0] < 2:
+        return np.empty(0)
+    # every triangle's three edges (ends sorted), with the corner opposite each
+    ends = np.stack([t[:, [1, 2]], t[:, [2, 0]], t[:, [0, 1]]], axis=1).reshape(-1, 2)
+    opposite = t.reshape(-1)
+    key = np.sort(ends, axis=1)
+    order = np.lexsort((key[:, 1], key[:, 0]))
+    k = key[order]
+    pair = np.flatnonzero((k[1:] == k[:-1]).all(axis=1))
+    if pair.size == 0:
+        return np.empty(0)
+    i, j = order[pair], order[pair + 1]
+    a, b = key[i, 0], key[i, 1]
+    c, d = opposite[i], opposite[j]
+
+    def angle(at, u, v):
+        x, y = p[u] - p[at], p[v] - p[at]
+        cos = (x * y).sum(axis=1) / np.maximum(norm(x) * norm(y), 1e-300)
+        return np.arccos(np.clip(cos, -1.0, 1.0))
+
+    near = angle(c, a, b) + angle(d, a, b) > np.pi - slack
+    if not near.any():
+        return np.empty(0)
+    a, b, c, d = a[near], b[near], c[near], d[near]
+    flipped = np.concatenate([np.stack([a, c, d], axis=1), np.stack([b, d, c], axis=1)])
+    return triangle_ratios(p, flipped)
+
+
 def closest_points_on_triangles(p, corners) -> tuple[np.ndarray, np.ndarray]:
     """Squared distance from each point to its triangle and the closest point's
     barycentric weights (Ericson, *Real-Time Collision Detection* 5.1.5).

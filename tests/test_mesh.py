@@ -94,6 +94,29 @@ def test_triangle_ratios_of_known_triangles():
     assert r[0] < np.sqrt(3) / 2 < r[1]
 
 
+def test_flipped_ratios_judge_a_near_cocircular_cell_with_its_other_diagonal():
+    from scipy.spatial import Delaunay
+
+    from sr33.mesh import flipped_ratios
+
+    # four corners near one circle (one of them 0.5 % outside it)
+    t = np.deg2rad([0.0, 100.0, 180.0, 250.0])
+    p = np.c_[np.cos(t), np.sin(t)] * np.array([1.0, 1.0, 1.0, 1.005])[:, None]
+    tri = Delaunay(p).simplices
+    shared = np.intersect1d(tri[0], tri[1])
+    other = np.setdiff1d(np.arange(4), shared)
+    # the other diagonal's two triangles, by brute force
+    want = triangle_ratios(p, [(shared[0], *other), (shared[1], *other)])
+    np.testing.assert_allclose(np.sort(flipped_ratios(p, tri, 0.05)), np.sort(want))
+    assert np.abs(np.sort(want) - np.sort(triangle_ratios(p, tri))).max() > 0.1  # it matters
+    assert flipped_ratios(p, tri, 1e-6).size == 0  # beyond the slack: not near cocircular
+    # a square lattice: every cell is cocircular, the flip is the mirror image
+    g = np.stack(np.meshgrid(np.arange(4.0), np.arange(4.0)), -1).reshape(-1, 2)
+    flipped = flipped_ratios(g, Delaunay(g).simplices, 1e-9)
+    assert flipped.size == 2 * 9  # nine cells, each with its other diagonal
+    np.testing.assert_allclose(flipped, 1 / np.sqrt(2))
+
+
 @given(arrays(np.float64, (4, 3), elements=st.floats(-3, 3)))
 def test_closest_point_beats_a_dense_sampling_of_the_triangle(q):
     from sr33.mesh import closest_points_on_triangles
