@@ -351,31 +351,32 @@ def triangle_ratios(points, triangles) -> np.ndarray:
         return length[:, 1] / length[:, 2]
 
 
-def flipped_ratios(points, triangles, slack: float) -> np.ndarray:
-    """Ratios (:func:`triangle_ratios`) of the triangles a near-cocircular
-    cell would have with its other diagonal.
+def near_cocircular(points, triangles, slack: float) -> np.ndarray:
+    """The cells of two triangles whose four corners are nearly on one circle.
 
     Where two triangles ``(a, b, c)`` and ``(b, a, d)`` share an edge and
     their angles at ``c`` and ``d`` sum to more than ``pi - slack``, the four
     corners are within ``slack`` of one circle: the Delaunay triangulation
     could as well take the diagonal ``c d``, and which one a triangulation
     (or a geodesic check on a tessellated truth) takes depends on tiny
-    differences.  Condition III-ii is met with a margin only if both
-    diagonals meet it.  Returns the ratios of the triangles ``(a, c, d)``
-    and ``(b, d, c)`` of every such cell (empty when there is none).
-    Works on 2-D points (a planar chart).
+    differences.  Works on 2-D points (a planar chart).
+
+    Returns
+    -------
+    (m, 4) int64
+        Every such cell's ``a, b, c, d`` (``a < b``), in the order of its
+        shared edge ``(a, b)``.
 
     Examples
     --------
-    A unit square's two triangulations are mirror images:
-
-    >>> np.round(flipped_ratios([[0, 0], [1, 0], [1, 1], [0, 1]], [(0, 1, 2), (0, 2, 3)], 0.01), 4)
-    array([0.7071, 0.7071])
+    >>> near_cocircular([[0, 0], [1, 0], [1, 1], [0, 1]], [(0, 1, 2), (0, 2, 3)], 0.01)
+    array([[0, 2, 1, 3]])
     """
     p = np.asarray(points, dtype=np.float64)
     t = as_triangles(triangles)
+    none = np.empty((0, 4), dtype=np.int64)
     if t.shape[0] < 2:
-        return np.empty(0)
+        return none
     # every triangle's three edges (ends sorted), with the corner opposite each
     ends = np.stack([t[:, [1, 2]], t[:, [2, 0]], t[:, [0, 1]]], axis=1).reshape(-1, 2)
     opposite = t.reshape(-1)
@@ -384,7 +385,7 @@ def flipped_ratios(points, triangles, slack: float) -> np.ndarray:
     k = key[order]
     pair = np.flatnonzero((k[1:] == k[:-1]).all(axis=1))
     if pair.size == 0:
-        return np.empty(0)
+        return none
     i, j = order[pair], order[pair + 1]
     a, b = key[i, 0], key[i, 1]
     c, d = opposite[i], opposite[j]
@@ -395,11 +396,30 @@ def flipped_ratios(points, triangles, slack: float) -> np.ndarray:
         return np.arccos(np.clip(cos, -1.0, 1.0))
 
     near = angle(c, a, b) + angle(d, a, b) > np.pi - slack
-    if not near.any():
+    return np.stack([a, b, c, d], axis=1)[near].astype(np.int64)
+
+
+def flipped_ratios(points, triangles, slack: float) -> np.ndarray:
+    """Ratios (:func:`triangle_ratios`) of the triangles a near-cocircular
+    cell (:func:`near_cocircular`) would have with its other diagonal.
+
+    Condition III-ii is met with a margin only if both diagonals of such a
+    cell meet it.  Returns the ratios of the triangles ``(a, c, d)`` and
+    ``(b, d, c)`` of every such cell, the first triangles of all cells first
+    (empty when there is none).
+
+    Examples
+    --------
+    A unit square's two triangulations are mirror images:
+
+    >>> np.round(flipped_ratios([[0, 0], [1, 0], [1, 1], [0, 1]], [(0, 1, 2), (0, 2, 3)], 0.01), 4)
+    array([0.7071, 0.7071])
+    """
+    cells = near_cocircular(points, triangles, slack)
+    if cells.shape[0] == 0:
         return np.empty(0)
-    a, b, c, d = a[near], b[near], c[near], d[near]
-    flipped = np.concatenate([np.stack([a, c, d], axis=1), np.stack([b, d, c], axis=1)])
-    return triangle_ratios(p, flipped)
+    flipped = np.concatenate([cells[:, [0, 2, 3]], cells[:, [1, 3, 2]]])
+    return triangle_ratios(np.asarray(points, dtype=np.float64), flipped)
 
 
 def closest_points_on_triangles(p, corners) -> tuple[np.ndarray, np.ndarray]:

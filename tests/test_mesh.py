@@ -117,6 +117,35 @@ def test_flipped_ratios_judge_a_near_cocircular_cell_with_its_other_diagonal():
     np.testing.assert_allclose(flipped, 1 / np.sqrt(2))
 
 
+def test_near_cocircular_names_each_cell_by_its_diagonal_and_opposite_corners():
+    from scipy.spatial import Delaunay
+
+    from sr33.mesh import near_cocircular
+
+    # a 3 x 2 grid of unit squares beside a far point: the two squares are
+    # cocircular cells, the triangles to the far point are not
+    g = np.array([[0, 0], [1, 0], [2, 0], [0, 1], [1, 1], [2, 1], [1, 5.0]])
+    tri = Delaunay(g).simplices
+    cells = near_cocircular(g, tri, 1e-9)
+    assert cells.shape == (2, 4)
+    for a, b, c, d in cells.tolist():
+        assert a < b
+        # a b is a square's diagonal, c and d its other corners
+        assert {a, b, c, d} in ({0, 1, 3, 4}, {1, 2, 4, 5})
+        assert np.isclose(np.linalg.norm(g[a] - g[b]), np.sqrt(2))
+        assert np.isclose(np.linalg.norm(g[c] - g[d]), np.sqrt(2))
+        # both triangles are among the triangulation's
+        have = {frozenset(t) for t in tri.tolist()}
+        assert {frozenset((a, b, c)), frozenset((a, b, d))} <= have
+    # their shared corner raised by 0.02: both cells about 0.04 rad off one
+    # circle, near within a slack of 0.05, not within 0.01
+    g2 = g.copy()
+    g2[4] = [1.0, 1.02]
+    tri2 = Delaunay(g2).simplices
+    assert len(near_cocircular(g2, tri2, 0.05)) == 2
+    assert len(near_cocircular(g2, tri2, 0.01)) == 0
+
+
 @given(arrays(np.float64, (4, 3), elements=st.floats(-3, 3)))
 def test_closest_point_beats_a_dense_sampling_of_the_triangle(q):
     from sr33.mesh import closest_points_on_triangles

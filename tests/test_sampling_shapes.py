@@ -530,21 +530,57 @@ def test_a_disk_layout_tries_other_ring_plans_until_one_meets_the_margin(monkeyp
     assert disks._layout(radii, 1.0).gap == disks.HALVE_GAP and seen == [(0, disks.HALVE_GAP)]
 
 
+def test_a_disk_layout_settles_its_near_cocircular_cells(monkeypatch):
+    """A repaired ring layout whose Delaunay triangles meet the margin can
+    keep a cell nearly on one circle whose other diagonal breaks it (a disk
+    of radius 8.12 h: 0.83 one way, above 0.835 the other); the settle
+    moves a corner by a few hundredths of t, rims fixed, until both
+    diagonals meet it, and the first ring plan is kept."""
+    from scipy.spatial import Delaunay, cKDTree
+
+    from sr33.mesh import flipped_ratios
+    from sr33.samplers import disks
+
+    radii = (8.12,)
+    lay = disks._layout(radii, 1.0)
+    monkeypatch.setattr(disks, "SETTLE_ROUNDS", 0)
+    raw = disks._layout_with(radii, 1.0, lay.gap, lay.extra)
+    assert raw.either >= disks.LAYOUT_GOOD > raw.worst  # the cell the settle is for
+    assert (lay.gap, lay.extra) == (disks.HALVE_GAPS[0], 0) and lay.settled >= 1
+    assert lay.either < disks.LAYOUT_GOOD and lay.worst < disks.LAYOUT_GOOD
+    # judged afresh: both diagonals of every near-cocircular cell below the margin
+    tri = Delaunay(lay.uv).simplices
+    assert flipped_ratios(lay.uv, tri, disks.COCIRCULAR).max() < disks.LAYOUT_GOOD
+    # the same samples, a few moved a little, the rims not at all
+    t, _ = disks.ring_plan(radii, 1.0, lay.gap, lay.extra)
+    assert lay.uv.shape == raw.uv.shape and np.array_equal(lay.rim, raw.rim)
+    moved = np.linalg.norm(lay.uv - raw.uv, axis=1)
+    assert 1 <= np.count_nonzero(moved) <= lay.settled and not moved[lay.rim].any()
+    assert moved.max() <= max(disks.SETTLE_STEPS) * t + 1e-12
+    assert cKDTree(lay.uv).query(lay.uv, 2)[0][:, 1].min() >= disks.SETTLE_CLOSEST * t - 1e-12
+
+
 @pytest.mark.slow
 def test_disk_layouts_meet_condition_iii_at_every_radius():
     """Every disk from 4 h to 34 h in radius (not only the library's): its
     rings' Delaunay triangles stay below 0.85 (HALVE_GAP alone left 6 of 30
-    radii between 0.887 and 0.978; 4.5 h needed a ring more)."""
+    radii between 0.887 and 0.978; 4.5 h needed a ring more), and so do
+    their near-cocircular cells with the other diagonal (without the settle,
+    7.09 h, 19.45 h and 20.48 h kept 0.842 or more at every ring plan)."""
     from scipy.spatial import Delaunay
 
-    from sr33.mesh import triangle_ratios
-    from sr33.samplers.disks import _layout
+    from sr33.mesh import flipped_ratios, triangle_ratios
+    from sr33.samplers.disks import COCIRCULAR, _layout
 
     for radius in [4.5, *np.round(np.arange(4.0, 34.0, 2.06), 3)]:
         lay = _layout((float(radius),), 1.0)
-        ratio = triangle_ratios(lay.uv, Delaunay(lay.uv).simplices)
+        tri = Delaunay(lay.uv).simplices
+        ratio = triangle_ratios(lay.uv, tri)
         assert ratio.max() < 0.85, (radius, ratio.max())
         assert ratio.max() == pytest.approx(lay.worst) and lay.either >= lay.worst
+        # near-cocircular cells with their other diagonal too (settled)
+        flipped = flipped_ratios(lay.uv, tri, COCIRCULAR)
+        assert np.r_[flipped, 0.0].max() < 0.85, (radius, flipped.max())
 
 
 @pytest.mark.parametrize("name", by_speed(["cone", "cylinder", "square_ring"]))
