@@ -780,6 +780,110 @@ def _first_passing(options, make, passes, rank=lambda _: 0):
     return min(tried, key=lambda x: rank(x[1]))
 
 
+@dataclass(frozen=True)
+class _ConeRings:
+    """A cone's repaired rings (:func:`_cone_rings`): slant distance, angle
+    and row of every sample (row -1: added by the repair), the rows laid,
+    and the repair's triangles left above its margin and worst ratio (None
+    where there was nothing to repair)."""
+
+    rho: np.ndarray
+    ang: np.ndarray
+    row: np.ndarray
+    rows: int
+    bad: int | None
+    worst: float | None
+    judged: float = 0.0  # :func:`_developed_worst`
+
+
+def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) -> float:
+    """The worst Condition III-ii ratio of a cone's rings on its development,
+    away from the glued sides (``APEX_JUDGED_SIDE`` t) and from the apex
+    (``APEX_JUDGED_FROM`` t): the Delaunay triangles of the samples (the
+    rim's and the apex included) laid out at polar coordinates
+    ``(rho, ang sin(a))``.  The development's repair reports only the
+    triangles it mended; this judges every ring (a cone of radius 0.37 by
+    height 0.8: 0.846 reported, 0.865 here and by the geodesic check)."""
+    theta = 2 * math.pi * sin_a
+    r = np.r_[rho, np.full(rim_ang.size, slant), 0.0]
+    psi = np.r_[ang, rim_ang, 0.0] * sin_a
+    uv = np.stack([r * np.cos(psi), r * np.sin(psi)], axis=1)
+    tri = Delaunay(uv).simplices
+    c = uv[tri].mean(axis=1)
+    rc = np.linalg.norm(c, axis=1)
+    pc = np.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
+    judged = (
+        (pc < theta)
+        & (rc * np.minimum(pc, theta - pc) > APEX_JUDGED_SIDE * t)
+        & (rc > APEX_JUDGED_FROM * t)
+        & (rc < slant)
+    )
+    return float(np.r_[triangle_ratios(uv, tri[judged]), 0.0].max())
+
+
+def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float, inner, limits):
+    """The rings of :func:`lattice_cone_faces` from the rim to the apex, repaired.
+
+    ``plan`` (:func:`sr33.samplers.rings.ring_positions`, ``reach`` rows kept
+    at the apex) places the rings and their halvings by design; the
+    ``reach - 1`` rows nearest the apex end their columns by their gaps
+    (:func:`_end_columns` with ``limits`` = (end gap, merged gap), times
+    t); the ring round the apex becomes a designed fan where one exists;
+    then the development's repair (:func:`_repair_developed`), once more
+    wider where it is left stuck.
+    """
+    end_gap, merged = limits
+    ang = rim_ang
+    rho_l, ang_l, row_l = [], [], []
+    designed = plan.at.size - (reach - 1) if plan.halves.any() else 0
+    for j, at_j in enumerate(plan.at, start=1):
+        rho = slant - at_j
+        if inner is not None and rho < inner[0] + INNER_GAP * t:
+            break
+        if plan.halves[j - 1]:
+            ang = ang[::2]
+        elif j > designed:
+            ang = _end_columns(ang, rho * sin_a, t, end_gap, merged)
+        if ang.size < 3:
+            break
+        rho_l.append(np.full(ang.size, rho))
+        ang_l.append(ang)
+        row_l.append(np.full(ang.size, j - 1))
+    keep = APEX_KEEP
+    fan = _apex_fan(2 * math.pi * sin_a) if rho_l and inner is None else None
+    if fan is not None:  # the ring round the apex becomes the designed fan
+        r1 = rho_l[-1][0]
+        rho_l[-1], ang_l[-1], row_l[-1] = fan.ring(r1, ang_l[-1][0], row_l[-1][0])
+        keep = FAN_KEEP * r1 / t
+    nrows = len(rho_l)
+    rho_a = np.concatenate(rho_l) if rho_l else np.empty(0)
+    ang_a = np.concatenate(ang_l) if ang_l else np.empty(0)
+    row_a = np.concatenate(row_l) if row_l else np.empty(0, np.int64)
+    if not rho_a.size:
+        return _ConeRings(rho_a, ang_a, row_a, nrows, None, None)
+    # a frustum's band is mended from the margin (no apex to spare)
+    broken_at = SQRT3_2 if inner is None else STUCK
+    got = _repair_developed(
+        rho_a, ang_a, row_a, rim_ang, slant, sin_a, t, keep, broken_at, inner=inner
+    )
+    # stuck: once more, wider, the apex's neighbourhood settled
+    if got[4] >= broken_at:
+        wide = _repair_developed(
+            *got[:3],
+            rim_ang,
+            slant,
+            sin_a,
+            t,
+            max(keep, APEX_SETTLED),
+            broken_at,
+            movable=WIDE_MOVABLE,
+            inner=inner,
+        )
+        got = wide if wide[4] < got[4] else got
+    judged = _developed_worst(got[0], got[1], rim_ang, slant, sin_a, t)
+    return _ConeRings(got[0], got[1], got[2], nrows, got[3], got[4], judged)
+
+
 def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     """Lay every full cone with a sampled rim out in rings that keep their columns.
 
@@ -793,9 +897,11 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     :data:`~sr33.samplers.rings.HALVING_GAP` row steps, on a ring placed
     there (:func:`sr33.samplers.rings.ring_positions`; the cone 0.859 ->
     0.832 by the geodesic check), except within ``APEX_REACH`` rows of the
-    apex, where two neighbouring columns closer than 0.75 h end one of them
-    (the one whose end leaves the narrower merged gap, at most 1.6 h): the
-    cells stay near-rectangles, with a pentagon where a column ends.
+    apex, where a column ends once its gap falls below an end gap and the
+    merged gap stays within a bound (:func:`_end_columns`; the pairs of
+    ``APEX_END_LIMITS`` in turn, until the repaired rings meet
+    ``APEX_GOOD``): the cells stay near-rectangles, with a pentagon where a
+    column ends.
     The ring round the apex becomes a designed fan of spokes
     (:func:`_apex_fan`) where one exists for the cone's angle.  Where the
     pentagons still break Condition III-ii (near the apex, or where an odd
@@ -857,8 +963,6 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         rows = steps(slant, h)
         t = slant / rows
         rim_ang = angles(rim)
-        ang = rim_ang
-        rho_l, ang_l, row_l = [], [], []
         # rings halving by design from the rim to the apex's last rows (one
         # step apart, ending columns by their gaps, repaired): the first of
         # APEX_REACH rows, then one to two fewer, then more, that no halving
@@ -869,52 +973,17 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
             lambda k, mer=meridian, t=t, m=rim_ang.size: ring_positions(*mer, t, m, keep=(1, k)),
             lambda p: p.moved == 0,
         )
-        designed = plan.at.size - (reach - 1) if plan.halves.any() else 0
-        for j, at_j in enumerate(plan.at, start=1):
-            rho = slant - at_j
-            if inner is not None and rho < inner[0] + INNER_GAP * t:
-                break
-            if plan.halves[j - 1]:
-                ang = ang[::2]
-            elif j > designed:
-                ang = _end_columns(ang, rho * sin_a, t)
-            if ang.size < 3:
-                break
-            rho_l.append(np.full(ang.size, rho))
-            ang_l.append(ang)
-            row_l.append(np.full(ang.size, j - 1))
-        keep = APEX_KEEP
-        fan = _apex_fan(2 * math.pi * sin_a) if rho_l and inner is None else None
-        if fan is not None:  # the ring round the apex becomes the designed fan
-            r1 = rho_l[-1][0]
-            rho_l[-1], ang_l[-1], row_l[-1] = fan.ring(r1, ang_l[-1][0], row_l[-1][0])
-            keep = FAN_KEEP * r1 / t
-        nrows = len(rho_l)
-        rho_a = np.concatenate(rho_l) if rho_l else np.empty(0)
-        ang_a = np.concatenate(ang_l) if ang_l else np.empty(0)
-        row_a = np.concatenate(row_l) if row_l else np.empty(0, np.int64)
-        bad = worst = None
-        if rho_a.size:
-            # a frustum's band is mended from the margin (no apex to spare)
-            broken_at = SQRT3_2 if inner is None else STUCK
-            got = _repair_developed(
-                rho_a, ang_a, row_a, rim_ang, slant, sin_a, t, keep, broken_at, inner=inner
-            )
-            # stuck: once more, wider, the apex's neighbourhood settled
-            if got[4] >= broken_at:
-                wide = _repair_developed(
-                    *got[:3],
-                    rim_ang,
-                    slant,
-                    sin_a,
-                    t,
-                    max(keep, APEX_SETTLED),
-                    broken_at,
-                    movable=WIDE_MOVABLE,
-                    inner=inner,
-                )
-                got = wide if wide[4] < got[4] else got
-            rho_a, ang_a, row_a, bad, worst = got
+        # the rows near the apex end their columns by the first of
+        # APEX_END_LIMITS whose repaired rings meet APEX_GOOD (else the lowest)
+        args = (plan, reach, rim_ang, slant, sin_a, t, inner)
+        limits, got = _first_passing(
+            APEX_END_LIMITS,
+            lambda lim, args=args: _cone_rings(*args, lim),
+            lambda g: round(g.judged, 9) < APEX_GOOD,
+            rank=lambda g: round(g.judged, 9),
+        )
+        rho_a, ang_a, row_a = got.rho, got.ang, got.row
+        nrows, bad, worst = got.rows, got.bad, got.worst
         z = rho_a * cos_a
         rr = rho_a * sin_a
         new = (
@@ -933,7 +1002,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         line += nrows
         report = {"face": fi, "kind": "cone rings", "rows": nrows, "samples": len(new)}
         if bad is not None:
-            report.update(bad=bad, worst=worst)
+            report.update(bad=bad, worst=worst, judged=got.judged, end_limits=limits)
         reports.append(report)
     return reports
 
@@ -945,6 +1014,22 @@ APEX_KEEP = 5.0  # samples this near the apex (times t) stay
 # worst 0.845 but the reconstruction splits off two closed pieces round the
 # apex; 14 and 16, 0.855; 20, 0.903
 APEX_REACH = 12
+#: the end gap and the largest merged gap (times t) by which the rows near a
+#: cone's apex end their columns (:func:`_end_columns`), tried in turn until
+#: the repaired rings' worst ratio (:func:`_developed_worst`) is below
+#: ``APEX_GOOD`` (else the lowest).
+#: A merged cell between two rows that taper towards the apex has the ratio
+#: ``b / sqrt(t^2 + ((a + b) / 2)^2)`` (b its outer gap, a = b (rho - t) /
+#: rho its inner one): 1.52 t at 11 rows from the apex makes 0.863, not the
+#: rectangle's 0.836, so the second pair keeps merged gaps within 1.45 t.
+#: Measured by the geodesic check: a cone of radius 0.37 by height 0.8, 42
+#: samples on two whole rings at 0.863 -> 0 (worst 0.835); 0.45 by 1.2, 34 ->
+#: 5 (the rest round the apex).  The library's cone and conebox keep the
+#: first (0.72 / 1.45 made conebox 0.853)
+APEX_END_LIMITS = ((END_GAP, END_MERGED), (0.72, 1.45))
+APEX_GOOD = 0.85
+APEX_JUDGED_SIDE = 2.0  # ... judged this far (times t) from the glued sides
+APEX_JUDGED_FROM = 6.0  # ... and from the apex (its fan and its repair's own)
 FAN_KEEP = 1.3  # ... or, round a designed fan, this near (times the fan's radius)
 FAN_RATIO = 0.85  # a fan's triangles keep their ratio (Condition III-ii) below this
 FAN_ANGLES = 165.0  # ... and its spokes' opposite angles below this sum (degrees)
@@ -1155,13 +1240,15 @@ def _repair_developed(
     return r2, a2, row2, int(out.bad), float(out.worst)
 
 
-def _end_columns(ang: np.ndarray, scale: float, t: float) -> np.ndarray:
+def _end_columns(
+    ang: np.ndarray, scale: float, t: float, end_gap: float = END_GAP, merged: float = END_MERGED
+) -> np.ndarray:
     """Columns (angles) left on a row of radius ``scale`` after ending the crowded ones.
 
     One walk round the row, starting at the column after the widest gap
     (the first on ties), which stays: a column ends when the gap from the
-    last column kept to it is below ``END_GAP`` t and the merged gap to
-    the next column stays within ``END_MERGED`` t, or when that gap is
+    last column kept to it is below ``end_gap`` t and the merged gap to
+    the next column stays within ``merged`` t, or when that gap is
     below ``NARROW`` t whatever the merged gap.  On a ring of equal gaps
     every other column ends.
     """
@@ -1176,9 +1263,9 @@ def _end_columns(ang: np.ndarray, scale: float, t: float) -> np.ndarray:
     for i in range(1, m):
         k = order[i]
         since += gap[order[i - 1]]
-        merged = since + gap[k]
+        joined = since + gap[k]
         if keep.sum() > 3 and (
-            (since < END_GAP * t and merged <= END_MERGED * t) or since < NARROW * t
+            (since < end_gap * t and joined <= merged * t) or since < NARROW * t
         ):
             keep[k] = False
         else:

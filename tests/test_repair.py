@@ -92,6 +92,24 @@ def test_ring_of_equal_gaps_ends_every_other_column():
     np.testing.assert_array_equal(_end_columns(ang, wide, 1.0), ang)
 
 
+def test_columns_end_within_the_limits_given():
+    """The limits near a cone's apex (``APEX_END_LIMITS``): with the second
+    pair a ring of gaps 0.76 t keeps every column (merged, 1.52 t would
+    exceed 1.45 t) and one of gaps 0.70 t ends every other (1.40 t)."""
+    import math
+
+    from sr33.samplers.layers import APEX_END_LIMITS, END_GAP, END_MERGED, _end_columns
+
+    ang = 2 * math.pi * np.arange(40) / 40
+    narrow = APEX_END_LIMITS[1]
+    at = 40 / (2 * math.pi)  # a scale giving gaps of 1 t
+    np.testing.assert_array_equal(_end_columns(ang, 0.76 * at, 1.0, *narrow), ang)
+    np.testing.assert_array_equal(_end_columns(ang, 0.70 * at, 1.0, *narrow), ang[1::2])
+    # the first pair is the default one
+    assert APEX_END_LIMITS[0] == (END_GAP, END_MERGED)
+    np.testing.assert_array_equal(_end_columns(ang, 0.76 * at, 1.0, *APEX_END_LIMITS[0]), ang[1::2])
+
+
 def test_halving_counts_are_three_four_or_five_times_a_power_of_two():
     from sr33.samplers.chart import halving_count
 

@@ -949,6 +949,33 @@ def test_a_cone_with_ten_apex_rows_reconstructs_as_one_closed_surface(monkeypatc
     assert rec.vertices.shape[0] == r.points.shape[0]
 
 
+@pytest.mark.slow
+def test_a_cones_apex_rows_end_their_columns_within_the_taper_limits():
+    """A cone of radius 0.37 by height 0.8 (not the library's proportions):
+    the rows near its apex, ending columns up to a merged gap of 1.65 t,
+    made two whole rings of tapering cells at 0.863 by the geodesic check
+    (42 samples) while the development's repair reported 0.846.  Judged on
+    the whole development, that layout fails ``APEX_GOOD`` and the second
+    pair of ``APEX_END_LIMITS`` is taken: conforming, and it reconstructs as
+    its B-rep does."""
+    pytest.importorskip("potpourri3d")
+    from sr33.reconstruct import reconstruct
+    from sr33.samplers import layers
+    from sr33.validators.conditions import sample_conditions
+
+    s = shapes.build("cone", radius=0.37, height=0.8)
+    r = scan(s)
+    (cone,) = [x for x in r.meta["repairs"] if x["kind"] == "cone rings"]
+    assert tuple(cone["end_limits"]) == layers.APEX_END_LIMITS[1]
+    assert cone["judged"] < layers.APEX_GOOD
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    assert rep.max_degree <= 33 and np.nanmax(rep.worst_ratio) < 0.85
+    rec = reconstruct(r.points, 33)
+    st = mesh_stats(rec.triangles, rec.vertices.shape[0])
+    assert (st.components, st.euler, st.open_edges, st.overloaded_edges) == (1, 2, 0, 0)
+    assert rec.vertices.shape[0] == r.points.shape[0]
+
+
 def test_a_frustums_samples_stay_on_its_surface():
     """A frustum's cone does not reach its apex: the cone layout
     (:func:`sr33.samplers.layers.lattice_cone_faces`) laid its rings on to
