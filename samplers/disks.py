@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay
 
-from sr33.mesh import dot, near_cocircular, norm, triangle_ratios
+from sr33.mesh import dot, flipped_triangles, near_cocircular, norm, triangle_ratios
 
 from .adjacency import EdgeFaces
 from .chart import halving_count, radial_clamp
@@ -319,37 +319,32 @@ def _layout_with(radii: tuple[float, ...], h: float, gap: float, extra: int = 0)
         rim = np.where(keep >= 0, rim[np.maximum(keep, 0)], False)
         ring = np.where(keep >= 0, ring[np.maximum(keep, 0)], -1)
         uv, bad = out.uv, int(out.bad)
-    worst, _, flipped = _judged(uv, inside)
-    either = max(worst, float(np.r_[flipped, 0.0].max()))
+    worst, either, _, _ = _judged(uv, inside)
     settled = 0
     if round(worst, 9) < LAYOUT_GOOD <= round(either, 9):
         uv, settled = _settle_cocircular(uv, ~rim, inside, clamp, t)
-        worst, _, flipped = _judged(uv, inside)
-        either = max(worst, float(np.r_[flipped, 0.0].max()))
+        worst, either, _, _ = _judged(uv, inside)
     return _Layout(uv, rim, ring, bad, worst, either, gap, extra, settled)
 
 
-def _judged(uv: np.ndarray, inside) -> tuple[float, np.ndarray, np.ndarray]:
-    """A layout's worst Delaunay ratio (triangles inside the face), its
-    near-cocircular cells (``COCIRCULAR``, :func:`sr33.mesh.near_cocircular`)
-    and the worse ratio of each cell's two triangles with the other diagonal."""
+def _judged(uv: np.ndarray, inside) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """A layout's worst Delaunay ratio (triangles inside the face), the worst
+    with near-cocircular cells judged with either diagonal too, those cells
+    (``COCIRCULAR``, :func:`sr33.mesh.near_cocircular`) and the worse ratio
+    of each cell's two triangles with the other diagonal."""
     tri = Delaunay(uv).simplices
     tri = tri[inside(uv[tri].mean(axis=1))]
     worst = float(np.r_[triangle_ratios(uv, tri), 0.0].max())
     cells = near_cocircular(uv, tri, COCIRCULAR)
-    flipped = np.concatenate([cells[:, [0, 2, 3]], cells[:, [1, 3, 2]]])
-    ratios = triangle_ratios(uv, flipped).reshape(2, -1).max(axis=0) if cells.size else np.empty(0)
-    return worst, cells, ratios
+    flipped = triangle_ratios(uv, flipped_triangles(cells)).reshape(2, -1).max(axis=0)
+    return worst, max(worst, float(np.r_[flipped, 0.0].max())), cells, flipped
 
 
-def _settle_rank(worst: float, flipped: np.ndarray) -> tuple:
+def _settle_rank(either: float, flipped: np.ndarray) -> tuple:
     """How :func:`_settle_cocircular` ranks a layout: its cells breaking the
     margin with the other diagonal, then the worst ratio either way (rounded
     to 1e-9, so that no last bit decides)."""
-    return (
-        int(np.count_nonzero(np.round(flipped, 9) >= LAYOUT_GOOD)),
-        round(max(worst, float(np.r_[flipped, 0.0].max())), 9),
-    )
+    return int(np.count_nonzero(np.round(flipped, 9) >= LAYOUT_GOOD)), round(either, 9)
 
 
 def _settle_cocircular(uv: np.ndarray, movable: np.ndarray, inside, clamp, t: float):
@@ -368,8 +363,8 @@ def _settle_cocircular(uv: np.ndarray, movable: np.ndarray, inside, clamp, t: fl
     A cell no move improves is left.  Returns the samples and the number of
     moves (at most ``SETTLE_ROUNDS``)."""
     uv = uv.copy()
-    worst, cells, flipped = _judged(uv, inside)
-    rank = _settle_rank(worst, flipped)
+    _, either, cells, flipped = _judged(uv, inside)
+    rank = _settle_rank(either, flipped)
     left: set[tuple] = set()
     moves = 0
     while moves < SETTLE_ROUNDS:
@@ -398,13 +393,13 @@ def _settle_cocircular(uv: np.ndarray, movable: np.ndarray, inside, clamp, t: fl
                 trial = uv.copy()
                 trial[v] = at
                 got = _judged(trial, inside)
-                r = _settle_rank(got[0], got[2])
+                r = _settle_rank(got[1], got[3])
                 if round(got[0], 9) < LAYOUT_GOOD and r < rank and (best is None or r < best[0]):
                     best = (r, trial, got)
         if best is None:
             left.add(tuple(sorted((a, b, c, d))))
             continue
-        rank, uv, (worst, cells, flipped) = best
+        rank, uv, (_, _, cells, flipped) = best
         moves += 1
     return uv, moves
 

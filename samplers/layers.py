@@ -796,6 +796,14 @@ class _ConeRings:
     judged: float = 0.0  # :func:`_developed_worst`
 
 
+def _developed(rho, ang, sin_a: float) -> np.ndarray:
+    """Samples at slant distance ``rho`` (one or per sample) and angle ``ang``
+    about a cone's axis, on the cone's development: polar coordinates
+    ``(rho, ang sin(a))``."""
+    psi = ang * sin_a
+    return np.stack([rho * np.cos(psi), rho * np.sin(psi)], axis=1)
+
+
 def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) -> float:
     """The worst Condition III-ii ratio of a cone's rings on its development,
     away from the glued sides (``APEX_JUDGED_SIDE`` t) and from the apex
@@ -805,9 +813,8 @@ def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) ->
     triangles it mended; this judges every ring (a cone of radius 0.37 by
     height 0.8: 0.846 reported, 0.865 here and by the geodesic check)."""
     theta = 2 * math.pi * sin_a
-    r = np.r_[rho, np.full(rim_ang.size, slant), 0.0]
-    psi = np.r_[ang, rim_ang, 0.0] * sin_a
-    uv = np.stack([r * np.cos(psi), r * np.sin(psi)], axis=1)
+    rim = _developed(slant, rim_ang, sin_a)
+    uv = np.vstack([_developed(rho, ang, sin_a), rim, np.zeros((1, 2))])  # the apex last
     tri = Delaunay(uv).simplices
     c = uv[tri].mean(axis=1)
     rc = np.linalg.norm(c, axis=1)
@@ -1189,17 +1196,14 @@ def _repair_developed(
     """
     full = sin_a >= 1.0 - 1e-12
     theta = 2 * math.pi * sin_a
-    psi = ang * sin_a
-    uv = np.stack([rho * np.cos(psi), rho * np.sin(psi)], axis=1)
-    rim_psi = rim_ang * sin_a
-    rim = slant * np.stack([np.cos(rim_psi), np.sin(rim_psi)], axis=1)
+    uv = _developed(rho, ang, sin_a)
+    rim = _developed(slant, rim_ang, sin_a)
     if inner is None:
         allp = np.vstack([uv, rim, np.zeros((1, 2))])
         hole = 0.0
     else:
         hole, low_ang = inner
-        low_psi = low_ang * sin_a
-        allp = np.vstack([uv, rim, hole * np.stack([np.cos(low_psi), np.sin(low_psi)], axis=1)])
+        allp = np.vstack([uv, rim, _developed(hole, low_ang, sin_a)])
 
     def inside(c: np.ndarray) -> np.ndarray:
         r = np.linalg.norm(c, axis=1)

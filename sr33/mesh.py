@@ -418,8 +418,22 @@ def flipped_ratios(points, triangles, slack: float) -> np.ndarray:
     cells = near_cocircular(points, triangles, slack)
     if cells.shape[0] == 0:
         return np.empty(0)
-    flipped = np.concatenate([cells[:, [0, 2, 3]], cells[:, [1, 3, 2]]])
-    return triangle_ratios(np.asarray(points, dtype=np.float64), flipped)
+    return triangle_ratios(np.asarray(points, dtype=np.float64), flipped_triangles(cells))
+
+
+def flipped_triangles(cells) -> np.ndarray:
+    """The triangles ``(a, c, d)`` and ``(b, d, c)`` of cells ``a, b, c, d``
+    (:func:`near_cocircular`) with their other diagonal, the first
+    triangles of all cells first: (2 m, 3).
+
+    Examples
+    --------
+    >>> flipped_triangles([[0, 2, 1, 3]])
+    array([[0, 1, 3],
+           [2, 3, 1]])
+    """
+    cells = np.asarray(cells, dtype=np.int64).reshape(-1, 4)
+    return np.concatenate([cells[:, [0, 2, 3]], cells[:, [1, 3, 2]]])
 
 
 def closest_points_on_triangles(p, corners) -> tuple[np.ndarray, np.ndarray]:
