@@ -148,7 +148,19 @@ def goes_round(face) -> bool:
 def revolution_axis(face):
     """(point, unit direction) of a cone's, cylinder's, sphere's or torus's
     axis (a sphere's and a torus's point is its centre)."""
-    g = face._geomAdaptor()
+    g = basis_surface(face)
     kind = {"CONE": "Cone", "CYLINDER": "Cylinder", "TORUS": "Torus"}.get(face.geomType(), "Sphere")
     pos = getattr(g, kind)().Position()
     return np.array(pos.Location().Coord()), np.array(pos.Direction().Coord())
+
+
+def basis_surface(face):
+    """The analytic surface under a B-rep face (``face._geomAdaptor()``),
+    through any rectangular trimming: a lofted frustum's face says "CONE"
+    but its surface is a trimmed one, whose ``Cone()`` does not exist."""
+    from OCP.Geom import Geom_RectangularTrimmedSurface
+
+    g = face._geomAdaptor()
+    while isinstance(g, Geom_RectangularTrimmedSurface):
+        g = g.BasisSurface()
+    return g

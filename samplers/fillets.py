@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .faces import exact_bounds, nearest_face, revolution_axis, steps, thin
+from .faces import basis_surface, exact_bounds, nearest_face, revolution_axis, steps, thin
 from .samples import Samples
 from .spheres import repair_sphere_face
 
@@ -74,7 +74,7 @@ def find_filleted_box(occ, tol: float) -> FilletedBox | None:
     ):
         return None
     lo, hi = exact_bounds(occ)
-    spheres = [f._geomAdaptor().Sphere() for f, k in zip(faces, kinds) if k == "SPHERE"]
+    spheres = [basis_surface(f).Sphere() for f, k in zip(faces, kinds) if k == "SPHERE"]
     r = float(spheres[0].Radius())
     if any(abs(float(sp.Radius()) - r) > tol for sp in spheres):
         return None
@@ -96,7 +96,7 @@ def find_filleted_box(occ, tol: float) -> FilletedBox | None:
     for f, k in zip(faces, kinds):
         if k != "CYLINDER":
             continue
-        if abs(float(f._geomAdaptor().Cylinder().Radius()) - r) > tol:
+        if abs(float(basis_surface(f).Cylinder().Radius()) - r) > tol:
             return None
         o, d = revolution_axis(f)
         a = int(np.argmax(np.abs(d)))

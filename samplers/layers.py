@@ -40,6 +40,7 @@ from .chart import (
     segment_distance,
 )
 from .faces import (
+    basis_surface,
     boundary_segments,
     goes_round,
     perpendicular,
@@ -723,7 +724,7 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     for fi, face in _full_turns(occ, "CYLINDER"):
         _, _, vmin, vmax = face._uvBounds()
-        cyl = face._geomAdaptor().Cylinder()
+        cyl = basis_surface(face).Cylinder()
         pos = cyl.Position()
         o = np.array(pos.Location().Coord())
         ex = np.array(pos.XDirection().Coord())
@@ -925,7 +926,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     tol = 1e-7 * size
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     for fi, face in _full_turns(occ, "CONE"):
-        cone = face._geomAdaptor().Cone()
+        cone = basis_surface(face).Cone()
         pos = cone.Position()
         apex = np.array(cone.Apex().Coord())
         loc = np.array(pos.Location().Coord())
@@ -1345,7 +1346,7 @@ def _repair_pole(
     row = [np.full(columns[j].size, j) for j in inner]
     sin_a, keep = 1.0, 0.5
     if kind == "CONE":
-        sin_a = math.sin(abs(face._geomAdaptor().Cone().SemiAngle()))
+        sin_a = math.sin(abs(basis_surface(face).Cone().SemiAngle()))
         fan = _apex_fan(2 * math.pi * sin_a)
         if fan is None:
             return [], [], [], None

@@ -76,6 +76,7 @@ from sr33.progress import bar, log, timed
 
 from .adjacency import EdgeFaces
 from .faces import (
+    basis_surface,
     exact_bounds,
     goes_round,
     nearest_face,
@@ -500,7 +501,7 @@ def _sphere_frame(face, d: np.ndarray):
     None for any other face."""
     if face.geomType() != "SPHERE" or goes_round(face):
         return None
-    sph = face._geomAdaptor().Sphere()
+    sph = basis_surface(face).Sphere()
     centre = np.array(sph.Location().Coord())
     e1 = perpendicular(d)
     return centre, float(sph.Radius()), e1, np.cross(d, e1), d

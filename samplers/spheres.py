@@ -27,7 +27,7 @@ import numpy as np
 from sr33.mesh import dot, norm
 
 from .chart import Arc, Raster, arc_clamp, arc_sides, segment_distance
-from .faces import boundary_segments, goes_round, perpendicular, rims_sampled
+from .faces import basis_surface, boundary_segments, goes_round, perpendicular, rims_sampled
 from .layers import POLE_GOOD, RASTER, unstuck
 from .repair import repair
 from .samples import Samples
@@ -196,7 +196,7 @@ def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=N
     sample is free)."""
     tol = 1e-7 * size
     fixed = s.on_feature if fixed is None else np.asarray(fixed, dtype=bool)
-    sph = face._geomAdaptor().Sphere()
+    sph = basis_surface(face).Sphere()
     centre = np.array(sph.Location().Coord())
     radius = float(sph.Radius())
     pole = np.array(face.Center().toTuple()) - centre

@@ -976,6 +976,25 @@ def test_a_cones_apex_rows_end_their_columns_within_the_taper_limits():
     assert rec.vertices.shape[0] == r.points.shape[0]
 
 
+@pytest.mark.slow
+def test_a_lofted_frustum_samples_as_the_made_one():
+    """A frustum lofted between two circles has a conical face whose surface
+    is a trimmed one: the cone layout asked it for ``Cone()`` and the
+    sampling died with an AttributeError.  The analytic surface under any
+    trimming (:func:`sr33.samplers.faces.basis_surface`) now serves: the
+    lofted frustum is sampled exactly as the one made as a cone."""
+    import cadquery as cq
+    from scipy.spatial import cKDTree
+
+    lofted = cq.Workplane("XY").circle(0.3).workplane(offset=0.4).circle(0.12).loft()
+    made = cq.Workplane("XY").add(cq.Solid.makeCone(0.3, 0.12, 0.4))
+    a = scan(shapes.from_cad(lofted), target_points=1500)
+    b = scan(shapes.from_cad(made), target_points=1500)
+    assert "cone rings" in {x["kind"] for x in a.meta["repairs"]}
+    assert a.points.shape == b.points.shape
+    assert cKDTree(b.points).query(a.points)[0].max() < 1e-9
+
+
 def test_a_frustums_samples_stay_on_its_surface():
     """A frustum's cone does not reach its apex: the cone layout
     (:func:`sr33.samplers.layers.lattice_cone_faces`) laid its rings on to
