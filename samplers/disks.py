@@ -45,7 +45,7 @@ from sr33.mesh import dot, flipped_triangles, near_cocircular, norm, triangle_ra
 
 from .adjacency import EdgeFaces
 from .chart import halving_count, radial_clamp
-from .faces import goes_round, perpendicular, steps
+from .faces import cap_rim, goes_round, perpendicular, steps
 from .repair import MOVABLE, repair
 from .samples import Samples
 
@@ -136,7 +136,8 @@ def round_faces(adjacency: EdgeFaces, tol: float) -> list[RoundFace]:
 
     A planar face bounded by one full circle or two concentric ones
     qualifies when across each circle lies nothing (an open rim), a full
-    cone (its rings start from the rim), or a full cylinder whose other rim
+    cone or a spherical cap (their rings start from the rim,
+    :func:`sr33.samplers.layers.lattice_sphere_caps`), or a full cylinder whose other rim
     also bounds a qualifying face (so that both rims carry the same
     columns, :func:`sr33.samplers.layers.lattice_cylinder_faces`).
     """
@@ -159,6 +160,8 @@ def _rim_ok(fi: int, edge, adjacency: EdgeFaces, found) -> bool:
     face = adjacency.faces[other]
     if face.geomType() == "CONE":
         return goes_round(face)
+    if face.geomType() == "SPHERE":  # a cap: its rings start from the rim
+        return cap_rim(face, 1e-7 * max(edge.radius(), 1e-300)) is not None
     if face.geomType() != "CYLINDER" or not goes_round(face):
         return False
     for e in face.Edges():

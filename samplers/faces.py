@@ -164,3 +164,37 @@ def basis_surface(face):
     while isinstance(g, Geom_RectangularTrimmedSurface):
         g = g.BasisSurface()
     return g
+
+
+def cap_rim(face, tol: float) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """The one circle a spherical cap's boundary runs round: (centre, unit
+    normal, radius); None when the face's edges (seams and degenerate poles
+    aside) are not arcs of one circle making it whole (a dome fused onto a
+    face, a dimple, a hemisphere: a cap; cutcube's scoop, bounded by three
+    arcs: not one)."""
+    from OCP.BRep import BRep_Tool
+
+    circles = []
+    for e in face.Edges():
+        if BRep_Tool.Degenerated_s(e.wrapped) or BRep_Tool.IsClosed_s(e.wrapped, face.wrapped):
+            continue
+        if e.geomType() != "CIRCLE":
+            return None
+        circ = e._geomAdaptor().Circle()
+        circles.append(
+            (
+                np.array(circ.Location().Coord()),
+                np.array(circ.Axis().Direction().Coord()),
+                float(circ.Radius()),
+                float(e.Length()),
+            )
+        )
+    if not circles:
+        return None
+    c0, n0, r0, _ = circles[0]
+    for c, n, r, _ in circles[1:]:
+        if norm(c - c0) > tol or abs(r - r0) > tol or abs(abs(dot(n, n0)) - 1) > 1e-9:
+            return None
+    if abs(sum(x[3] for x in circles) - 2 * math.pi * r0) > 1e-6 * r0:
+        return None
+    return c0, n0, r0

@@ -42,6 +42,7 @@ from .chart import (
 from .faces import (
     basis_surface,
     boundary_segments,
+    cap_rim,
     goes_round,
     perpendicular,
     revolution_axis,
@@ -49,7 +50,7 @@ from .faces import (
     steps,
 )
 from .repair import GAP, MOVABLE, Repaired, copies, repair, split_corners
-from .rings import ring_positions
+from .rings import HALVING_GAP, ring_positions
 from .samples import Samples
 
 LAYER = 2.5  # samples within this many h of a circular edge may move
@@ -1553,3 +1554,265 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
             "pole_reach": reach,
         }
     ] + reports
+
+
+CAP_WIDEST = 1.25  # a cap past its equator: the equator at most this many times the rim's radius
+#: a cap's rings halve at one of these gaps (times t; ``HALVING_GAP`` first):
+#: a sphere's rings shrink towards its pole, and the merged cells after a
+#: halving are trapezoids, not the rectangles the gap balances (a cap of
+#: radius 12.5 t: 0.853 after a halving at 0.707)
+CAP_GAPS = (HALVING_GAP, 0.68, 0.66, 0.64)
+CAP_DESIGN = 0.84  # the designed rings of a cap's layout meet this on its map
+CAP_TRIES = 6  # layouts repaired at most, in :func:`_cap_plans`' order
+CAP_POLE_GAP = 0.75  # round the pole a ring halves rather than let its gaps fall below this (t)
+
+
+@dataclass(frozen=True)
+class _Cap:
+    """A spherical cap in units of its row step t: the sphere's radius, the
+    rim's distance from the pole along the meridian (``slant``) and radius,
+    the rim samples' angles about the pole, and the meridian from the rim
+    (arc lengths, radii; the radii held at the rim's past the equator)."""
+
+    radius: float
+    slant: float
+    rim_radius: float
+    rim_ang: np.ndarray
+    mer_s: np.ndarray
+    mer_r: np.ndarray
+
+    def to_map(self, sigma) -> np.ndarray:
+        """Distance from the pole -> radius on the stereographic map from the
+        pole's antipode, isometric at the pole."""
+        return 2.0 * self.radius * np.tan(np.asarray(sigma, dtype=np.float64) / (2.0 * self.radius))
+
+    def from_map(self, rho) -> np.ndarray:
+        return (
+            2.0 * self.radius * np.arctan(np.asarray(rho, dtype=np.float64) / (2.0 * self.radius))
+        )
+
+    def worst(self, sigma, ang, beyond: float = 0.0) -> tuple[float, int]:
+        """Worst Condition III-ii ratio of the cap's samples (rim and pole
+        included) and the triangles at or above ``STUCK``, judged on the map:
+        its Delaunay triangles are the sphere's (the map takes circles to
+        circles) and keep their ratios up to the scale's change across them.
+        Only triangles whose corners are all ``beyond`` or farther from the
+        pole are judged."""
+        sig = np.r_[sigma, np.full(self.rim_ang.size, self.slant), 0.0]
+        uv = _developed(self.to_map(sig), np.r_[ang, self.rim_ang, 0.0], 1.0)
+        tri = Delaunay(uv).simplices
+        tri = tri[sig[tri].min(axis=1) >= beyond - 1e-9]
+        ratio = triangle_ratios(uv, tri)
+        return float(np.r_[ratio, 0.0].max()), int((ratio >= STUCK).sum())
+
+
+def _cap_rings(cap: _Cap, reach: int, gap: float):
+    """The rings of :func:`lattice_sphere_caps` before their repair: every
+    sample's distance from the pole, angle and ring, and the first ring of
+    the pole's zone: ``reach`` rows round the pole one step apart, ending
+    their columns by their gaps; the rings outside halve where their gap is
+    ``gap`` t."""
+    plan = ring_positions(cap.mer_s, cap.mer_r, 1.0, cap.rim_ang.size, keep=(1, reach), gap=gap)
+    n_ring = plan.at.size
+    first = n_ring - reach + 1
+    sig, ang_l, row = [], [], []
+    ang = cap.rim_ang
+    for j in range(n_ring):
+        if plan.halves[j]:
+            ang = ang[::2]
+        elif j >= first:  # a disk's rule: the largest halving whose gaps stay wide enough
+            r = float(np.interp(plan.at[j], cap.mer_s, cap.mer_r))
+            while ang.size % 2 == 0 and ang.size >= 6 and 2 * math.pi * r / ang.size < CAP_POLE_GAP:
+                ang = ang[::2]
+        while j == n_ring - 1 and ang.size > 5 and ang.size % 2 == 0:
+            ang = ang[::2]  # the ring round the pole: at most 5 columns
+        sig.append(np.full(ang.size, cap.slant - plan.at[j]))
+        ang_l.append(ang)
+        row.append(np.full(ang.size, j))
+    return np.concatenate(sig), np.concatenate(ang_l), np.concatenate(row), first
+
+
+def _cap_plans(cap: _Cap, reaches) -> list[tuple[int, float]]:
+    """(reach, halving gap) of the cap's layouts worth repairing, in the
+    order to try them: those whose designed rings (outside the pole's zone,
+    which is repaired) meet Condition III-ii with ``CAP_DESIGN`` on the map,
+    the fewest bad triangles in the pole's zone first (the repair's cost
+    and its chance of ending stuck grow with them), then in the order of
+    ``reaches`` and ``CAP_GAPS``; all of them, in that order, where none
+    does.  Plans laying the same rings as one before are left out."""
+    ranked = []
+    seen = set()
+    for k, reach in enumerate(reaches):
+        for g, gap in enumerate(CAP_GAPS):
+            sig, ang, row, first = _cap_rings(cap, reach, gap)
+            key = (first, sig.tobytes(), ang.tobytes())
+            if key in seen:
+                continue  # the same rings as a plan before (no halving moved)
+            seen.add(key)
+            outer = float(sig[row == first - 1][0])
+            design, _ = cap.worst(sig, ang, beyond=outer)
+            _, bad = cap.worst(sig, ang)
+            ranked.append((round(design, 9) >= CAP_DESIGN, bad, k, g, (reach, gap)))
+    ranked.sort(key=lambda x: x[:4])
+    return [x[-1] for x in ranked]
+
+
+def _cap_repaired(cap: _Cap, reach: int, gap: float):
+    """:func:`_cap_rings` with the pole's zone repaired on the cap's map
+    (:func:`_repair_developed`, no cut: the zone's outer ring and the pole
+    fixed); returns (sigma, angle, ring; -1 for an added sample), the
+    repair's bad count and worst ratio, and the whole cap's
+    (:meth:`_Cap.worst`)."""
+    sig, ang, row, first = _cap_rings(cap, reach, gap)
+    zone = row >= first
+    outer = row == first - 1
+    args = (ang[outer], float(cap.to_map(sig[outer][0])), 1.0, 1.0, 0.5, POLE_GOOD)
+    got = _repair_developed(cap.to_map(sig[zone]), ang[zone], row[zone], *args)
+    if got[4] >= POLE_GOOD:  # stuck: once more, wider, as a cone's rings
+        wide = _repair_developed(*got[:3], *args, movable=WIDE_MOVABLE)
+        got = wide if wide[4] < got[4] else got
+    r2, a2, row2, bad, worst = got
+    sig = np.r_[sig[~zone], cap.from_map(r2)]
+    ang = np.r_[ang[~zone], a2]
+    row = np.r_[row[~zone], row2]
+    return sig, ang, row, bad, worst, cap.worst(sig, ang)[0]
+
+
+def lattice_sphere_caps(occ, s: Samples, h: float, size: float) -> tuple[list[dict], set[int]]:
+    """Lay every spherical cap with a sharp rim out in rings from its rim to its pole.
+
+    A cap is a sphere's face bounded by one circle (:func:`cap_rim`): a dome
+    fused onto a face, a dimple cut into one, a hemisphere on its disk.
+    Its scan rows stagger like a cone's, and the stereographic repair of
+    :func:`sr33.samplers.spheres.repair_sphere_faces` does not reach a face
+    as wide as a hemisphere (a dome of radius 11 h: 401 of its samples
+    violating Condition III-ii, a hemisphere on its disk 39%).  It is laid
+    out as :func:`lattice_cone_faces` lays a cone:
+
+    * the rim is sampled again, at :func:`halving_count` columns evenly
+      spaced from its vertex, so that the columns halve cleanly down to the
+      3 to 5 round the pole (the scan's own count, 76 on that dome, halved
+      to 19 and then unevenly), unless its samples are so spaced already (a
+      disk laid out across it, :func:`sr33.samplers.disks.lattice_disk_faces`);
+      the planar faces across the rim are repaired afterwards, round it;
+    * the meridian from the rim to the pole is cut into ``round(S / h)``
+      equal steps t, every step a ring (a parallel about the rim's axis)
+      that keeps the columns of the ring before it, every other column
+      ending on a ring placed where the gap reaches a halving gap
+      (:func:`sr33.samplers.rings.ring_positions`; one of ``CAP_GAPS``:
+      the rings shrink towards the pole, and the trapezoids after a
+      halving need a narrower gap than a cylinder's rectangles);
+    * the ``reach`` rings round the pole stand one step apart and halve
+      by a disk's rule (``CAP_POLE_GAP``), the last at 3 to 5 columns
+      round a sample at the pole; they are repaired on the cap's
+      stereographic map from the pole's antipode (:func:`_repair_developed`,
+      no cut, the zone's outer ring fixed; once more wider where stuck).
+      The map is conformal and takes circles to circles, so its Delaunay
+      triangles are the sphere's, with their ratios up to the scale's
+      change across a triangle (the azimuthal map of a ball's poles,
+      :func:`_repair_pole`, shrinks circles by ``sin(x) / x``: 12% over a
+      small cap's 10 rows).
+
+    The plans (reach of ``POLE_REACHES``, or all rows but two and fewer on a
+    cap too small for them; halving gap) are ranked by :func:`_cap_plans`
+    and repaired in turn, at most ``CAP_TRIES``, until the whole cap meets
+    ``POLE_GOOD`` on its map (:meth:`_Cap.worst`), else the best is kept.
+    A cap past its equator keeps the rim's columns to the equator (their
+    gaps grow by at most ``CAP_WIDEST``; a wider one is left to the scan
+    rows).  Returns the reports and the faces laid out.
+    """
+    reports = []
+    done: set[int] = set()
+    tol = 1e-7 * size
+    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
+    for fi, face in enumerate(occ.Faces()):
+        if face.geomType() != "SPHERE":
+            continue
+        rim_circle = cap_rim(face, tol)
+        if rim_circle is None:
+            continue
+        cc, nn, rr = rim_circle
+        sph = basis_surface(face).Sphere()
+        c = np.array(sph.Location().Coord())
+        radius = float(sph.Radius())
+        pole = nn if dot(np.array(face.Center().toTuple()) - cc, nn) > 0 else -nn
+        theta = math.atan2(rr, float(dot(cc - c, pole)))  # the rim's angle from the pole
+        if theta > math.pi / 2 and radius > CAP_WIDEST * rr:
+            continue
+        q = s.points - c
+        on = np.abs(np.linalg.norm(q, axis=1) - radius) < tol * 10
+        height = dot(q, pole)
+        level = radius * math.cos(theta)
+        rim = np.flatnonzero(on & (np.abs(height - level) < tol * 10))
+        if rim.size < 3 or 2 * s.on_feature[rim].sum() < rim.size:
+            continue  # a smooth rim (cone_tip's ball, laid out with its cone)
+        rows = steps(radius * theta, h)
+        # a small cap: fewer rows round its pole (all but the first two)
+        reaches = [k for k in POLE_REACHES if k <= rows - 2] or list(range(rows - 2, 1, -1))
+        if not reaches:
+            continue
+        t = radius * theta / rows
+        ex = perpendicular(pole)
+        ey = np.cross(pole, ex)
+        rim_ang = np.sort(np.arctan2(dot(q[rim], ey), dot(q[rim], ex)) % (2 * math.pi))
+        gaps = np.diff(np.r_[rim_ang, rim_ang[0] + 2 * math.pi])
+        if rim.size != halving_count(rim.size) or np.ptp(gaps) > 1e-6 * gaps.mean():
+            corner = np.array(face.Vertices()[0].toTuple()) - c if face.Vertices() else ex
+            start = math.atan2(float(dot(corner, ey)), float(dot(corner, ex)))
+            m = halving_count(2 * math.pi * rr / h)
+            rim_ang = np.sort((start + 2 * math.pi * np.arange(m) / m) % (2 * math.pi))
+            pts = cc + rr * (np.cos(rim_ang)[:, None] * ex + np.sin(rim_ang)[:, None] * ey)
+            ids, counts = np.unique(s.face_id[rim], return_counts=True)
+            fid = int(ids[np.argmax(counts)])  # the rim's face, as the scan had it
+            s.replace(rim, pts, np.full(m, -1), np.full(m, fid), np.ones(m, dtype=bool))
+            q = s.points - c
+            on = np.abs(np.linalg.norm(q, axis=1) - radius) < tol * 10
+            height = dot(q, pole)
+        # in units of t, that the layout and its repair do not hinge on its last bits
+        mer_s = np.linspace(0.0, rows, 2001)
+        cap = _Cap(
+            radius / t,
+            float(rows),
+            rr / t,
+            rim_ang,
+            mer_s,
+            np.minimum(radius / t * np.sin(theta - mer_s * t / radius), rr / t),
+        )
+        (reach, gap), (sig, ang, row, bad, worst, judged) = _first_passing(
+            _cap_plans(cap, reaches)[:CAP_TRIES],
+            lambda plan, cap=cap: _cap_repaired(cap, *plan),
+            lambda x: round(x[-1], 9) < POLE_GOOD,
+            lambda x: round(x[-1], 9),
+        )
+        inside = np.flatnonzero(on & (height > level + tol * 10))
+        at_pole = inside[np.linalg.norm(q[inside] - radius * pole, axis=1) < tol * 10]
+        if not at_pole.size:  # a sample at the pole (unless it is a vertex there)
+            sig, ang, row = np.r_[sig, 0.0], np.r_[ang, 0.0], np.r_[row, -1]
+        x = sig * t / radius
+        new = c + radius * (
+            np.cos(x)[:, None] * pole
+            + np.sin(x)[:, None] * (np.cos(ang)[:, None] * ex + np.sin(ang)[:, None] * ey)
+        )
+        s.replace(
+            np.setdiff1d(inside, at_pole),
+            new,
+            np.where(row >= 0, line + row, -3),
+            np.full(new.shape[0], fi),
+            np.zeros(new.shape[0], dtype=bool),
+        )
+        line += int(row.max()) + 1
+        done.add(fi)
+        reports.append(
+            {
+                "face": fi,
+                "kind": "cap rings",
+                "rows": rows,
+                "samples": int(new.shape[0]),
+                "pole_reach": int(reach),
+                "halving_gap": gap,
+                "bad": int(bad),
+                "worst": float(worst),
+                "judged": judged,
+            }
+        )
+    return reports, done

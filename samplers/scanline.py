@@ -863,7 +863,7 @@ def scan(
             on_feature=res.on_feature,
             meta=meta,
         )
-    with bar(len(faces) + 2 + (8 if repair else 0), "sample", quiet, unit="step") as pbar:
+    with bar(len(faces) + 2 + (9 if repair else 0), "sample", quiet, unit="step") as pbar:
         lo, hi = exact_bounds(occ)
         size = float(norm(hi - lo))
         if area / (h * h * ratio) > 2_000_000:
@@ -956,6 +956,7 @@ def scan(
                 lattice_cone_faces,
                 lattice_cylinder_faces,
                 lattice_revolved_body,
+                lattice_sphere_caps,
                 repair_planar_faces,
             )
             from .pyramids import lattice_pyramid
@@ -967,6 +968,7 @@ def scan(
                 ("pyramids", lattice_pyramid),
                 ("filleted boxes", lattice_filleted_box),
                 ("disks", lattice_disk_faces),
+                ("spherical caps", lattice_sphere_caps),
             ):
                 with timed(f"sample: {step}"):
                     more, done = layout(occ, bag, h, size)
