@@ -273,7 +273,11 @@ def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float):
     lattice, anchored on its least and dividing its own span
     (:func:`_anchored`; edges at one offset keep the default spacing).  A
     family whose edges already lie on the default lattice (boxes, models
-    measured in round numbers) keeps it unchanged.
+    measured in round numbers) keeps it unchanged.  A family whose faces
+    have no such edges (a cylinder standing on a box) is anchored on the
+    other faces' straight edges across ``d`` the same way, so that the rows
+    along ``d`` elsewhere (sampled on this lattice) meet those edges'
+    samples (the box's sides, 0.3 h off its vertical edges' samples before).
     """
     family: dict[int, tuple[float, float]] = {}
     own: dict[int, tuple[float, float]] = {}  # faces on a lattice of their own
@@ -283,7 +287,10 @@ def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float):
         t0 = float(proj.min())
         hf = _dividing_step(float(proj.max()) - t0, h)
         mine = [i for i in range(len(faces)) if fam[i] == k]
-        shared = _anchored(np.array(sorted(o for i in mine for o in offsets[i])), t0, hf, h, tol)
+        own_edges = sorted(o for i in mine for o in offsets[i])
+        if not own_edges:  # the other faces' edges across d (a post on a box)
+            own_edges = sorted({o for f in faces for o in _parallel_edge_offsets(f, dirs[k], tol)})
+        shared = _anchored(np.array(own_edges), t0, hf, h, tol)
         family[k] = shared or (t0, hf)
         if shared is not None:
             continue
@@ -297,6 +304,42 @@ def _aligned_planes(faces, fam, dirs, corner, h: float, tol: float):
                     _dividing_step(float(off[-1] - off[0]), h),
                 )
     return [own.get(i, family[fam[i]]) for i in range(len(faces))], family
+
+
+def _anchor_axes(faces, dirs, family, anchor, axis_steps, ratio: float, h: float, tol: float):
+    """Anchor the lattice along each coordinate axis that no family of scan
+    planes sets, in place: on the straight edges across that axis, as a
+    family's planes are (:func:`_anchored`).
+
+    A row along an axis is sampled on that axis's lattice, by default the
+    bounding box's (its extent over a whole number of steps).  A box under
+    a dome has its top edges inside the box, off that lattice, and the
+    rows of its sides then end 0.3 h from the top edges' samples, staggered
+    against its vertical edges' (a box of 0.6 under a dome rising to 0.9:
+    0.941 there by the geodesic check).  Straight edges across the axis
+    anchor the lattice instead, when one lattice holds them all; when they
+    lie on the default lattice already (boxes, models measured in round
+    numbers) nothing changes.
+    """
+    set_by_family = {
+        a for k in family if (a := _axis_index(dirs[k])) is not None and dirs[k][a] > 0
+    }
+    offsets: list[list[float]] = [[], [], []]
+    for face in faces:
+        for e in face.Edges():
+            if e.geomType() != "LINE":
+                continue
+            p = np.array(e.startPoint().toTuple())
+            v = np.array(e.endPoint().toTuple()) - p
+            for a in range(3):
+                if norm(v) > tol and abs(float(v[a])) <= 1e-9 * norm(v):
+                    offsets[a].append(float(p[a]))
+    for a in range(3):
+        if a in set_by_family or not offsets[a]:
+            continue
+        got = _anchored(np.unique(offsets[a]), float(anchor[a]), axis_steps[a] / ratio, h, tol)
+        if got is not None:
+            anchor[a], axis_steps[a] = got[0], ratio * got[1]
 
 
 def _face_family(face, dirs: np.ndarray, tol: float) -> int:
@@ -889,6 +932,7 @@ def scan(
             if a is not None and dirs[k][a] > 0:
                 anchor[a] = t0
                 axis_steps[a] = ratio * hf
+        _anchor_axes(faces, dirs, family, anchor, axis_steps, ratio, h, tol)
         for fi, face in enumerate(faces):
             d = dirs[fam[fi]]
             t0, hf = aligned[fi]

@@ -205,3 +205,33 @@ def test_no_two_samples_closer_than_a_quarter_step():
     feature = np.array([False, True, False, False, True, False])
     np.testing.assert_array_equal(_distinct(p, feature, 0.25), [1, 2, 4])
     np.testing.assert_array_equal(_distinct(p[[0, 2, 4]], feature[[0, 2, 4]], 0.25), [0, 1, 2])
+
+
+@pytest.mark.parametrize("on_top", ["post", "dome", "none"])
+def test_a_boxs_side_rows_meet_its_vertical_edges_samples_whatever_stands_on_it(on_top):
+    """A cylinder or a dome on a box raises the bounding box, whose lattice
+    along the vertical then no longer holds the box's top edges: the rows of
+    the box's sides were sampled 0.3 h off the vertical edges' samples
+    (0.941 by the geodesic check at the box's top corners).  Anchored on
+    the straight edges across the axis, every side sample stands at a
+    height of the vertical edges' lattice."""
+    import cadquery as cq
+
+    from sr33.samplers import shapes
+
+    solid = cq.Solid.makeBox(1, 1, 0.6, pnt=cq.Vector(-0.5, -0.5, -0.6))
+    if on_top == "post":
+        solid = solid.fuse(cq.Solid.makeCylinder(0.15, 0.3, pnt=cq.Vector(0.1, 0.05, 0)))
+    elif on_top == "dome":
+        solid = solid.fuse(cq.Solid.makeSphere(0.25, angleDegrees1=-90, angleDegrees2=90))
+    s = scan(shapes.from_cad(solid, name=on_top), target_points=3000, repair=False)
+    p = s.points
+    corner = np.isclose(np.abs(p[:, 0]), 0.5) & np.isclose(np.abs(p[:, 1]), 0.5)
+    edge_z = np.unique(np.round(p[corner, 2], 9))
+    assert edge_z[0] == pytest.approx(-0.6) and edge_z[-1] == pytest.approx(0.0)
+    m = edge_z.size - 1
+    np.testing.assert_allclose(edge_z, -0.6 + 0.6 * np.arange(m + 1) / m, atol=1e-9)
+    side = np.isclose(np.abs(p[:, 0]), 0.5) | np.isclose(np.abs(p[:, 1]), 0.5)
+    q = (p[side, 2] + 0.6) * m / 0.6
+    assert side.sum() > 500
+    assert np.abs(q - np.round(q)).max() < 1e-6
