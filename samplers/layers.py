@@ -1757,7 +1757,10 @@ def lattice_sphere_caps(occ, s: Samples, h: float, size: float) -> tuple[list[di
         rim_ang = np.sort(np.arctan2(dot(q[rim], ey), dot(q[rim], ex)) % (2 * math.pi))
         gaps = np.diff(np.r_[rim_ang, rim_ang[0] + 2 * math.pi])
         if rim.size != halving_count(rim.size) or np.ptp(gaps) > 1e-6 * gaps.mean():
-            corner = np.array(face.Vertices()[0].toTuple()) - c if face.Vertices() else ex
+            # from the rim's vertex (not the pole's, whose angle is noise)
+            corners = [np.array(v.toTuple()) - c for v in face.Vertices()]
+            corners = [v for v in corners if abs(float(dot(v, pole)) - level) < tol * 10]
+            corner = corners[0] if corners else ex
             start = math.atan2(float(dot(corner, ey)), float(dot(corner, ex)))
             m = halving_count(2 * math.pi * rr / h)
             rim_ang = np.sort((start + 2 * math.pi * np.arange(m) / m) % (2 * math.pi))
