@@ -147,13 +147,13 @@ def round_faces(adjacency: EdgeFaces, tol: float) -> list[RoundFace]:
     while changed:
         changed = False
         for fi in sorted(found):
-            if not all(_rim_ok(fi, e, adjacency, found) for e in found[fi].edges):
+            if not all(_rim_ok(fi, e, adjacency, found, tol) for e in found[fi].edges):
                 del found[fi]
                 changed = True
     return [found[fi] for fi in sorted(found)]
 
 
-def _rim_ok(fi: int, edge, adjacency: EdgeFaces, found) -> bool:
+def _rim_ok(fi: int, edge, adjacency: EdgeFaces, found, tol: float) -> bool:
     other = adjacency.other(edge, fi)
     if other < 0:
         return True
@@ -161,7 +161,7 @@ def _rim_ok(fi: int, edge, adjacency: EdgeFaces, found) -> bool:
     if face.geomType() == "CONE":
         return goes_round(face)
     if face.geomType() == "SPHERE":  # a cap: its rings start from the rim
-        return cap_rim(face, 1e-7 * max(edge.radius(), 1e-300)) is not None
+        return cap_rim(face, tol) is not None
     if face.geomType() != "CYLINDER" or not goes_round(face):
         return False
     for e in face.Edges():

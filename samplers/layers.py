@@ -39,6 +39,7 @@ from .chart import (
     radial_clamp,
     segment_distance,
 )
+from .disks import HALVE_GAP
 from .faces import (
     basis_surface,
     boundary_segments,
@@ -1564,19 +1565,17 @@ CAP_WIDEST = 1.25  # a cap past its equator: the equator at most this many times
 CAP_GAPS = (HALVING_GAP, 0.68, 0.66, 0.64)
 CAP_DESIGN = 0.84  # the designed rings of a cap's layout meet this on its map
 CAP_TRIES = 6  # layouts repaired at most, in :func:`_cap_plans`' order
-CAP_POLE_GAP = 0.75  # round the pole a ring halves rather than let its gaps fall below this (t)
 
 
 @dataclass(frozen=True)
 class _Cap:
     """A spherical cap in units of its row step t: the sphere's radius, the
-    rim's distance from the pole along the meridian (``slant``) and radius,
-    the rim samples' angles about the pole, and the meridian from the rim
-    (arc lengths, radii; the radii held at the rim's past the equator)."""
+    rim's distance from the pole along the meridian (``slant``), the rim
+    samples' angles about the pole, and the meridian from the rim (arc
+    lengths, radii; the radii held at the rim's past the equator)."""
 
     radius: float
     slant: float
-    rim_radius: float
     rim_ang: np.ndarray
     mer_s: np.ndarray
     mer_r: np.ndarray
@@ -1591,19 +1590,20 @@ class _Cap:
             2.0 * self.radius * np.arctan(np.asarray(rho, dtype=np.float64) / (2.0 * self.radius))
         )
 
-    def worst(self, sigma, ang, beyond: float = 0.0) -> tuple[float, int]:
-        """Worst Condition III-ii ratio of the cap's samples (rim and pole
-        included) and the triangles at or above ``STUCK``, judged on the map:
-        its Delaunay triangles are the sphere's (the map takes circles to
-        circles) and keep their ratios up to the scale's change across them.
-        Only triangles whose corners are all ``beyond`` or farther from the
-        pole are judged."""
+    def ratios(self, sigma, ang) -> tuple[np.ndarray, np.ndarray]:
+        """Condition III-ii ratio of every Delaunay triangle of the cap's
+        samples (rim and pole included) on the map, and the distance of its
+        corner nearest the pole: the map's Delaunay triangles are the
+        sphere's (it takes circles to circles) and keep their ratios up to
+        the scale's change across them."""
         sig = np.r_[sigma, np.full(self.rim_ang.size, self.slant), 0.0]
         uv = _developed(self.to_map(sig), np.r_[ang, self.rim_ang, 0.0], 1.0)
         tri = Delaunay(uv).simplices
-        tri = tri[sig[tri].min(axis=1) >= beyond - 1e-9]
-        ratio = triangle_ratios(uv, tri)
-        return float(np.r_[ratio, 0.0].max()), int((ratio >= STUCK).sum())
+        return triangle_ratios(uv, tri), sig[tri].min(axis=1)
+
+    def worst(self, sigma, ang) -> float:
+        """The worst of :meth:`ratios`."""
+        return float(np.r_[self.ratios(sigma, ang)[0], 0.0].max())
 
 
 def _cap_rings(cap: _Cap, reach: int, gap: float):
@@ -1622,7 +1622,7 @@ def _cap_rings(cap: _Cap, reach: int, gap: float):
             ang = ang[::2]
         elif j >= first:  # a disk's rule: the largest halving whose gaps stay wide enough
             r = float(np.interp(plan.at[j], cap.mer_s, cap.mer_r))
-            while ang.size % 2 == 0 and ang.size >= 6 and 2 * math.pi * r / ang.size < CAP_POLE_GAP:
+            while ang.size % 2 == 0 and ang.size >= 6 and 2 * math.pi * r / ang.size < HALVE_GAP:
                 ang = ang[::2]
         while j == n_ring - 1 and ang.size > 5 and ang.size % 2 == 0:
             ang = ang[::2]  # the ring round the pole: at most 5 columns
@@ -1649,9 +1649,10 @@ def _cap_plans(cap: _Cap, reaches) -> list[tuple[int, float]]:
             if key in seen:
                 continue  # the same rings as a plan before (no halving moved)
             seen.add(key)
+            ratio, nearest = cap.ratios(sig, ang)
             outer = float(sig[row == first - 1][0])
-            design, _ = cap.worst(sig, ang, beyond=outer)
-            _, bad = cap.worst(sig, ang)
+            design = float(np.r_[ratio[nearest >= outer - 1e-9], 0.0].max())
+            bad = int((ratio >= STUCK).sum())
             ranked.append((round(design, 9) >= CAP_DESIGN, bad, k, g, (reach, gap)))
     ranked.sort(key=lambda x: x[:4])
     return [x[-1] for x in ranked]
@@ -1675,7 +1676,7 @@ def _cap_repaired(cap: _Cap, reach: int, gap: float):
     sig = np.r_[sig[~zone], cap.from_map(r2)]
     ang = np.r_[ang[~zone], a2]
     row = np.r_[row[~zone], row2]
-    return sig, ang, row, bad, worst, cap.worst(sig, ang)[0]
+    return sig, ang, row, bad, worst, cap.worst(sig, ang)
 
 
 def lattice_sphere_caps(occ, s: Samples, h: float, size: float) -> tuple[list[dict], set[int]]:
@@ -1702,9 +1703,9 @@ def lattice_sphere_caps(occ, s: Samples, h: float, size: float) -> tuple[list[di
       (:func:`sr33.samplers.rings.ring_positions`; one of ``CAP_GAPS``:
       the rings shrink towards the pole, and the trapezoids after a
       halving need a narrower gap than a cylinder's rectangles);
-    * the ``reach`` rings round the pole stand one step apart and halve
-      by a disk's rule (``CAP_POLE_GAP``), the last at 3 to 5 columns
-      round a sample at the pole; they are repaired on the cap's
+    * the ``reach`` rings round the pole stand one step apart and halve by
+      a disk's rule (:data:`sr33.samplers.disks.HALVE_GAP`), the last at 3
+      to 5 columns round a sample at the pole; they are repaired on the cap's
       stereographic map from the pole's antipode (:func:`_repair_developed`,
       no cut, the zone's outer ring fixed; once more wider where stuck).
       The map is conformal and takes circles to circles, so its Delaunay
@@ -1776,7 +1777,6 @@ def lattice_sphere_caps(occ, s: Samples, h: float, size: float) -> tuple[list[di
         cap = _Cap(
             radius / t,
             float(rows),
-            rr / t,
             rim_ang,
             mer_s,
             np.minimum(radius / t * np.sin(theta - mer_s * t / radius), rr / t),

@@ -324,20 +324,13 @@ def _anchor_axes(faces, dirs, family, anchor, axis_steps, ratio: float, h: float
     set_by_family = {
         a for k in family if (a := _axis_index(dirs[k])) is not None and dirs[k][a] > 0
     }
-    offsets: list[list[float]] = [[], [], []]
-    for face in faces:
-        for e in face.Edges():
-            if e.geomType() != "LINE":
-                continue
-            p = np.array(e.startPoint().toTuple())
-            v = np.array(e.endPoint().toTuple()) - p
-            for a in range(3):
-                if norm(v) > tol and abs(float(v[a])) <= 1e-9 * norm(v):
-                    offsets[a].append(float(p[a]))
     for a in range(3):
-        if a in set_by_family or not offsets[a]:
+        if a in set_by_family:
             continue
-        got = _anchored(np.unique(offsets[a]), float(anchor[a]), axis_steps[a] / ratio, h, tol)
+        offsets = {o for f in faces for o in _parallel_edge_offsets(f, np.eye(3)[a], tol)}
+        if not offsets:
+            continue
+        got = _anchored(np.array(sorted(offsets)), float(anchor[a]), axis_steps[a] / ratio, h, tol)
         if got is not None:
             anchor[a], axis_steps[a] = got[0], ratio * got[1]
 

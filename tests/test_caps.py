@@ -85,7 +85,6 @@ def test_a_caps_rings_keep_nested_columns_down_to_at_most_five_round_its_pole(
     cap = _Cap(
         radius / t,
         float(rows),
-        rr / t,
         2 * math.pi * np.arange(m) / m,
         mer_s,
         np.minimum(radius / t * np.sin(theta - mer_s * t / radius), rr / t),

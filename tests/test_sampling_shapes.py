@@ -923,6 +923,16 @@ def test_turned_rims_disks_and_scoops_meet_condition_iii(sampled, name):
         assert _reports(r, "cylinder lattice") == _reports(upright, "cylinder lattice")
 
 
+def _reconstructs_as_one_closed_sphere(points):
+    """The reconstruction (k = 33) is one closed genus-0 surface through every sample."""
+    from sr33.reconstruct import reconstruct
+
+    rec = reconstruct(points, 33)
+    st = mesh_stats(rec.triangles, rec.vertices.shape[0])
+    assert (st.components, st.euler, st.open_edges, st.overloaded_edges) == (1, 2, 0, 0)
+    assert rec.vertices.shape[0] == points.shape[0]
+
+
 @pytest.mark.slow
 def test_a_cone_with_ten_apex_rows_reconstructs_as_one_closed_surface(monkeypatch):
     """The default cone laid with 10 rows (not 12) repaired round its apex
@@ -934,7 +944,6 @@ def test_a_cone_with_ten_apex_rows_reconstructs_as_one_closed_surface(monkeypatc
     Euler characteristic.  Now a detached piece sends the cycles round it to
     the fallback, and a bubbled selection loses to any valid answer."""
     pytest.importorskip("potpourri3d")
-    from sr33.reconstruct import reconstruct
     from sr33.samplers import layers
     from sr33.validators.conditions import sample_conditions
 
@@ -943,10 +952,7 @@ def test_a_cone_with_ten_apex_rows_reconstructs_as_one_closed_surface(monkeypatc
     r = scan(s)
     rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
     assert rep.max_degree <= 33 and np.nanmax(rep.worst_ratio) <= 0.85  # conforming
-    rec = reconstruct(r.points, 33)
-    st = mesh_stats(rec.triangles, rec.vertices.shape[0])
-    assert (st.components, st.euler, st.open_edges, st.overloaded_edges) == (1, 2, 0, 0)
-    assert rec.vertices.shape[0] == r.points.shape[0]
+    _reconstructs_as_one_closed_sphere(r.points)
 
 
 @pytest.mark.slow
@@ -959,7 +965,6 @@ def test_a_cones_apex_rows_end_their_columns_within_the_taper_limits():
     pair of ``APEX_END_LIMITS`` is taken: conforming, and it reconstructs as
     its B-rep does."""
     pytest.importorskip("potpourri3d")
-    from sr33.reconstruct import reconstruct
     from sr33.samplers import layers
     from sr33.validators.conditions import sample_conditions
 
@@ -970,10 +975,7 @@ def test_a_cones_apex_rows_end_their_columns_within_the_taper_limits():
     assert cone["judged"] < layers.APEX_GOOD
     rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
     assert rep.max_degree <= 33 and np.nanmax(rep.worst_ratio) < 0.85
-    rec = reconstruct(r.points, 33)
-    st = mesh_stats(rec.triangles, rec.vertices.shape[0])
-    assert (st.components, st.euler, st.open_edges, st.overloaded_edges) == (1, 2, 0, 0)
-    assert rec.vertices.shape[0] == r.points.shape[0]
+    _reconstructs_as_one_closed_sphere(r.points)
 
 
 @pytest.mark.slow
