@@ -21,6 +21,7 @@ CadQuery and OCP are imported when the functions run.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -1093,6 +1094,7 @@ class Fan:
 FAN_CHORD = 0.4  # an uneven fan's neighbouring spoke ends keep this far apart (times t)
 
 
+@functools.lru_cache(maxsize=64)
 def _apex_fan(theta: float) -> Fan | None:
     """Spokes round a cone's apex that meet Condition III-ii, or None.
 
@@ -1115,6 +1117,7 @@ def _apex_fan(theta: float) -> Fan | None:
     ratio (cone_tip's 126° development: spokes 1, 1 and 0.76 with gaps of
     82°, 22° and 22°, ratio 0.76).  None qualifies below 83° nor at 115°
     and 116°.  Deterministic: the first of equal fans in grid order.
+    Remembered per ``theta`` (a cone's layouts ask for their fan in turn).
     """
     grid = np.round(np.arange(0.40, 1.0001, 0.01), 2)
     best = None

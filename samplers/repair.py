@@ -31,7 +31,9 @@ Delaunay triangle meets the condition with a margin:
   run again.
 
 The domain is 2-D (a planar face in plane coordinates).  Everything is
-plain numpy and scipy's Delaunay; no randomness.
+numpy and scipy's Delaunay, with the energy and its gradient in a numba
+kernel (:mod:`sr33.samplers._repair_kernels`, bit for bit the numpy code it
+replaced); no randomness.
 """
 
 from __future__ import annotations
@@ -45,6 +47,8 @@ from scipy.spatial import Delaunay, QhullError, cKDTree
 
 from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
+
+from ._repair_kernels import energy_terms
 
 TARGET = 0.78  # the descent pushes every ratio below this
 BAD = 0.83  # a triangle above this still needs work (margin below sqrt(3)/2)
@@ -67,7 +71,6 @@ GOOD_ENOUGH = 0.85  # further attempts (after a first one broke III-ii) end belo
 RETRY_BAD = 20
 ATTEMPTS = 6  # ... up to this many in all, from the input shaken
 STALL = 16  # ... each ending after this many edits without fewer bad triangles
-_EDGES = np.array([[0, 1], [1, 2], [2, 0]])
 GHOST, FRAME = -1, -2  # the sample id of a ghost point and of a frame point
 
 
@@ -262,99 +265,41 @@ def _summed(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
 
 def _energy(prob: _Problem, subset=None, active=None):
     """Energy, its gradient on the samples, the ratios, the triangles (as
-    sample ids) and their corners' positions."""
+    sample ids) and their corners' positions (the terms:
+    :func:`sr33.samplers._repair_kernels.energy_terms`)."""
     pts, of, turned, tri = _triangles(prob, subset)
-    h = prob.h
     grad = np.zeros_like(prob.uv)
     if tri.shape[0] == 0:
         return 0.0, grad, np.empty(0), tri, pts[tri]
     # triangles on a ghost are not the face's; those on the frame are, when they
-    # have a movable sample (the rest of the frame's cannot change)
-    kind = of[tri]
-    real = kind >= 0
-    movable = real & (prob.free | prob.slide)[np.maximum(kind, 0)]
-    tri = tri[(kind != GHOST).all(axis=1) & (real.all(axis=1) | movable.any(axis=1))]
+    # have a movable sample (the rest of the frame's cannot change); judged,
+    # those with a watched (and active) sample
+    move = prob.free | prob.slide
     watch = prob.watch()
-    active = watch if active is None else active & watch
-    tri = tri[(active[np.maximum(of[tri], 0)] & (of[tri] >= 0)).any(axis=1)]
-    p = pts[tri]
-    vec = p[:, _EDGES[:, 0]] - p[:, _EDGES[:, 1]]  # (m, 3, 2)
-    length = np.linalg.norm(vec, axis=2)
-    if subset is not None:  # several regions at once: no triangle joins two
-        near = length.max(axis=1) <= REACH * h
-        tri, p, vec, length = tri[near], p[near], vec[near], length[near]
-    if tri.shape[0] == 0:
-        return 0.0, grad, np.empty(0), tri, p
-    order = np.argsort(length, axis=1, kind="stable")
-    rows = np.arange(tri.shape[0])
-    i2, i3 = order[:, 1], order[:, 2]
-    l2, l3 = length[rows, i2], length[rows, i3]
-    rho = l2 / l3
-    over = np.maximum(0.0, rho - TARGET)
-    energy = float((over**2).sum())
-    # the gradient's terms, summed per point at the end in this order (one
-    # bincount: the same sequence of additions as np.add.at term by term)
-    at: list[np.ndarray] = []
-    terms: list[np.ndarray] = []
-
-    def push(edge_col, coef):
-        a = tri[rows, _EDGES[edge_col, 0]]
-        b = tri[rows, _EDGES[edge_col, 1]]
-        unit = vec[rows, edge_col] / length[rows, edge_col][:, None]
-        at.extend((a, b))
-        terms.extend((coef[:, None] * unit, -coef[:, None] * unit))
-
-    push(i2, 2 * over / l3)
-    push(i3, -2 * over * l2 / l3**2)
-    # short edges
-    short = np.maximum(0.0, SHORT * h - length) / h
-    energy += float((short**2).sum()) / 2.0  # each interior edge is seen twice
-    for col in range(3):
-        push(np.full(tri.shape[0], col), -short[:, col] / h)
-    # samples sliding along one edge keep their spacing within [0.75 h, 1.35 h]
-    # (and from the anchors, the fixed corners ending their runs): the
-    # lattice of the face on the other side starts from them
-    ends = of[tri[:, _EDGES]]  # (m, 3, 2) sample ids of every edge's ends
-    real_ends = ends >= 0
-    ids = np.maximum(ends, 0)
-    both = (real_ends & (prob.slide | prob.anchor)[ids]).all(axis=2) & ~(
-        real_ends & prob.anchor[ids]
-    ).all(axis=2)
-    if both.any():
-        gap = (
-            np.where(
-                both,
-                np.maximum(0.0, GAP[0] * h - length) - np.maximum(0.0, length - GAP[1] * h),
-                0.0,
-            )
-            / h
-        )
-        energy += 5.0 * float((gap**2).sum()) / 2.0
-        for col in range(3):
-            push(np.full(tri.shape[0], col), -10.0 * gap[:, col] / h)
-    # circumradius R = abc / (4 area): penalise holes in the coverage
-    cross = vec[:, 0, 0] * (-vec[:, 2, 1]) - vec[:, 0, 1] * (-vec[:, 2, 0])
-    area = 0.5 * np.abs(cross)
-    # (capped: a sliver's radius would overflow the square below)
-    radius = np.minimum(length.prod(axis=1) / np.maximum(4.0 * area, 1e-300), 1e6 * h)
-    wide = np.maximum(0.0, radius - prob.wide * h) / h
-    energy += float((wide**2).sum())
-    # a simple gradient for the radius term: pull the triangle's corners to its centroid
-    cen = p.mean(axis=1)
-    pull = (
-        (2 * wide / h)[:, None, None]
-        * (p - cen[:, None, :])
-        / np.maximum(radius, 1e-300)[:, None, None]
+    h = prob.h
+    energy, gp, rho, rows = energy_terms(
+        pts,
+        of,
+        np.ascontiguousarray(tri, dtype=np.int64),
+        move,
+        prob.slide | prob.anchor,
+        prob.anchor,
+        watch if active is None else active & watch,
+        0.0 if subset is None else REACH * h,  # several regions at once: no triangle joins two
+        h,
+        TARGET,
+        SHORT,
+        GAP[0],
+        GAP[1],
+        prob.wide,
     )
-    at.append(tri.ravel())
-    terms.append(pull.reshape(-1, 2))
-    gp = _summed(np.concatenate(at), np.concatenate(terms), pts.shape[0])
+    tri = tri[rows]
     real = of >= 0
     if prob.turn is not None:  # an image's gradient, turned back onto its sample
         gp = rotate(gp, -turned)
     grad = _summed(of[real], gp[real], grad.shape[0])
-    grad[~(prob.free | prob.slide)] = 0.0
-    return energy, grad, rho, of[tri], p
+    grad[~move] = 0.0
+    return energy, grad, rho, of[tri], pts[tri]
 
 
 def _descend(prob: _Problem, steps: int, subset=None, active=None, centres=None) -> None:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._numba import njit
+from .jit import njit
 
 _TOL = 1e-12  # barycentric and segment-parameter slack of the crossing test
 _FOLD = 1.0 - 1e-12  # cosine above which two triangles on one edge fold

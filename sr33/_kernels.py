@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._numba import njit
+from .jit import njit
 
 
 @njit(cache=True)

@@ -203,11 +203,11 @@ def test_a_kernel_compiled_in_this_run_is_announced_once():
 
 
 def test_a_cached_or_compiled_kernel_is_not_announced_again():
-    from sr33 import _numba
+    from sr33 import jit
 
     reconstruct(cube_lattice(3), 8)  # compiled or loaded now
     told = []
-    with _numba.compile_notice(lambda: told.append(1)):
+    with jit.compile_notice(lambda: told.append(1)):
         reconstruct(cube_lattice(3), 8)
     assert told == []
 

@@ -1,9 +1,10 @@
 """numba, as every kernel module of sr33 uses it: cached where it can be,
 announced when it compiles.
 
-The low layer (``sr33._intersect``) and the reconstruction's kernels
-(``sr33._kernels``) both compile through :func:`njit` here, so that one
-fallback (no cache folder) and one notice cover them all.
+The low layer (``sr33._intersect``), the reconstruction's kernels
+(``sr33._kernels``) and the sampler's (``sr33.samplers._repair_kernels``) all
+compile through :func:`njit` here, so that one fallback (no cache folder)
+covers them all, and one notice the reconstruction's.
 """
 
 from __future__ import annotations

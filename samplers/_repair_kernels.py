@@ -1,0 +1,262 @@
+"""numba kernel of the repair (:mod:`sr33.samplers.repair`): its energy and
+the energy's gradient over the Delaunay triangles of a step.
+
+Bit for bit the numpy code it replaced: the same operations in the same
+order, the sums as numpy sums (its pairwise summation, :func:`_pairwise`),
+every gradient term added per point in the order ``np.bincount`` added them
+(the ratio's terms, then the short edges', the gaps', the radii's).  A
+sampling is a local search whose end can turn on a last bit; a faster
+energy must not move one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sr33.jit import njit
+
+
+@njit(cache=True)
+def _block(a, lo, n):
+    """``a[lo:lo + n].sum()`` for n <= 128, as numpy: a plain loop below 8,
+    else 8 partial sums combined pairwise, then the rest."""
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[lo + i]
+        return res
+    r = np.empty(8)
+    for j in range(8):
+        r[j] = a[lo + j]
+    i = 8
+    while i < n - (n % 8):
+        for j in range(8):
+            r[j] += a[lo + i + j]
+        i += 8
+    res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True)
+def _pairwise(a):
+    """``a.sum()`` of a contiguous float64 array as numpy sums it
+    (``pairwise_sum`` of its ``loops_utils``): blocks of at most 128 by
+    :func:`_block`, longer runs halved at a multiple of 8 and the halves'
+    sums added.  The recursion runs on an explicit stack (numba's cache
+    does not hold recursive functions)."""
+    # tasks: (lo, n) to sum, or n = -1: add the last two sums
+    task_lo = np.empty(256, dtype=np.int64)
+    task_n = np.empty(256, dtype=np.int64)
+    sums = np.empty(128)
+    tasks, depth = 1, 0
+    task_lo[0], task_n[0] = 0, a.size
+    while tasks:
+        tasks -= 1
+        lo, n = task_lo[tasks], task_n[tasks]
+        if n < 0:
+            depth -= 1
+            sums[depth - 1] = sums[depth - 1] + sums[depth]
+        elif n <= 128:
+            sums[depth] = _block(a, lo, n)
+            depth += 1
+        else:
+            n2 = n // 2
+            n2 -= n2 % 8
+            # popped in reverse: the first half, the second, then their sum
+            task_lo[tasks], task_n[tasks] = 0, -1
+            task_lo[tasks + 1], task_n[tasks + 1] = lo + n2, n - n2
+            task_lo[tasks + 2], task_n[tasks + 2] = lo, n2
+            tasks += 3
+    return sums[0] if depth else 0.0
+
+
+@njit(cache=True)
+def numpy_sum(a):
+    """``a.sum()`` of a contiguous float64 array, bit for bit as numpy."""
+    return _pairwise(a.ravel())
+
+
+@njit(cache=True)
+def _edge_sum(terms, by_row):
+    """The sum of per-edge ``terms`` (3, m), edge column by column, or
+    triangle by triangle where ``by_row``."""
+    return numpy_sum(terms.T.copy() if by_row else terms)
+
+
+@njit(cache=True)
+def _push(gp, tri, rows, vec, length, col, coef, far):
+    """The gradient terms of one edge per triangle (``col`` (m,), an edge's
+    column: corners ``col`` and ``col + 1``), ``coef`` times its unit vector
+    at its first corner, all triangles in turn, then minus that at its
+    second (``far``: the order ``np.bincount`` saw them in)."""
+    m = rows.size
+    for k in range(m):
+        c = col[k]
+        ux = vec[k, c, 0] / length[k, c]
+        uy = vec[k, c, 1] / length[k, c]
+        v = tri[rows[k], c] if not far else tri[rows[k], (c + 1) % 3]
+        if not far:
+            gp[v, 0] += coef[k] * ux
+            gp[v, 1] += coef[k] * uy
+        else:
+            gp[v, 0] += -coef[k] * ux
+            gp[v, 1] += -coef[k] * uy
+
+
+@njit(cache=True)
+def _edge(gp, tri, rows, vec, length, col, coef):
+    _push(gp, tri, rows, vec, length, col, coef, False)
+    _push(gp, tri, rows, vec, length, col, coef, True)
+
+
+@njit(cache=True)
+def energy_terms(
+    pts, of, tri, move, hold, anchor, judged, reach, h, target, short, gap_lo, gap_hi, wide
+):
+    """The repair's energy over the Delaunay triangles ``tri`` of the
+    extended points ``pts`` (each the sample ``of`` says, -1 for a ghost,
+    -2 for a judged frame point) and its gradient on those points.
+
+    A triangle counts when it has no ghost, has a ``judged`` sample and
+    either only samples or a movable one (``move``); with ``reach`` > 0,
+    only when its longest edge is at most ``reach``.  Terms per triangle
+    (h the spacing): ``max(0, rho - target)**2`` (rho = second-longest over
+    longest edge); ``max(0, short h - l)**2 / h**2 / 2`` per edge (an
+    interior edge is seen twice); ``5 g**2 / 2`` per edge between two
+    samples sliding or anchored (not both anchored), g the excess outside
+    ``[gap_lo h, gap_hi h]`` over h (its gradient weighted 10 g), so that
+    the samples of an edge keep the spacing the lattice of the face across
+    it starts from; and ``max(0, R - wide h)**2 / h**2`` for the
+    circumradius R (capped at 1e6 h: a sliver's would overflow the square),
+    whose gradient pulls the corners to the centroid.
+
+    Returns the energy, the gradient on ``pts`` (P, 2), the ratios of the
+    triangles that count and their rows in ``tri``.
+    """
+    npts = pts.shape[0]
+    gp = np.zeros((npts, 2))
+    m0 = tri.shape[0]
+    rows = np.empty(m0, dtype=np.int64)
+    m = 0
+    for t in range(m0):
+        ghost = False
+        real = 0
+        movable = False
+        seen = False
+        for j in range(3):
+            s = of[tri[t, j]]
+            if s == -1:
+                ghost = True
+            elif s >= 0:
+                real += 1
+                movable = movable or move[s]
+                seen = seen or judged[s]
+        if not ghost and seen and (real == 3 or movable):
+            rows[m] = t
+            m += 1
+    # edge j of a triangle runs from corner j to corner j + 1
+    vec = np.empty((m, 3, 2))
+    length = np.empty((m, 3))
+    near = np.empty(m, dtype=np.int64)
+    k = 0
+    for q in range(m):
+        t = rows[q]
+        longest = 0.0
+        for j in range(3):
+            a, b = tri[t, j], tri[t, (j + 1) % 3]
+            vx = pts[a, 0] - pts[b, 0]
+            vy = pts[a, 1] - pts[b, 1]
+            vec[k, j, 0] = vx
+            vec[k, j, 1] = vy
+            length[k, j] = np.sqrt(vx * vx + vy * vy)
+            longest = max(longest, length[k, j])
+        if reach > 0.0 and not longest <= reach:
+            continue
+        near[k] = t
+        k += 1
+    rows = near[:k]
+    vec = vec[:k]
+    length = length[:k]
+    m = k
+    rho = np.empty(m)
+    over = np.empty(m)
+    i2 = np.empty(m, dtype=np.int64)
+    i3 = np.empty(m, dtype=np.int64)
+    for q in range(m):
+        # the edges in order of length, ties by column (a stable argsort)
+        o0, o1, o2 = 0, 1, 2
+        if length[q, o1] < length[q, o0]:
+            o0, o1 = o1, o0
+        if length[q, o2] < length[q, o1]:
+            o1, o2 = o2, o1
+            if length[q, o1] < length[q, o0]:
+                o0, o1 = o1, o0
+        i2[q], i3[q] = o1, o2
+        rho[q] = length[q, o1] / length[q, o2]
+        over[q] = max(0.0, rho[q] - target)
+    energy = numpy_sum(over * over)
+    coef = np.empty(m)
+    for q in range(m):
+        coef[q] = 2 * over[q] / length[q, i3[q]]
+    _edge(gp, tri, rows, vec, length, i2, coef)
+    for q in range(m):
+        l2, l3 = length[q, i2[q]], length[q, i3[q]]
+        coef[q] = -2 * over[q] * l2 / (l3 * l3)
+    _edge(gp, tri, rows, vec, length, i3, coef)
+    # short edges
+    # (numpy summed the edges' terms in the order it held their lengths in
+    # memory: column by column as its fancy indexing left them, row by row
+    # once the reach filter had copied them; hence ``_edge_sum``)
+    sh = np.empty((3, m))
+    for q in range(m):
+        for j in range(3):
+            sh[j, q] = max(0.0, short * h - length[q, j]) / h
+    energy += _edge_sum(sh * sh, reach > 0.0) / 2.0
+    col = np.empty(m, dtype=np.int64)
+    for j in range(3):
+        col[:] = j
+        for q in range(m):
+            coef[q] = -sh[j, q] / h
+        _edge(gp, tri, rows, vec, length, col, coef)
+    # samples sliding along one edge keep their spacing
+    gap = np.zeros((3, m))
+    both = False
+    for q in range(m):
+        t = rows[q]
+        for j in range(3):
+            sa, sb = of[tri[t, j]], of[tri[t, (j + 1) % 3]]
+            if sa >= 0 and sb >= 0 and hold[sa] and hold[sb] and not (anchor[sa] and anchor[sb]):
+                both = True
+                g = max(0.0, gap_lo * h - length[q, j]) - max(0.0, length[q, j] - gap_hi * h)
+                gap[j, q] = g / h
+    if both:
+        energy += 5.0 * _edge_sum(gap * gap, reach > 0.0) / 2.0
+        for j in range(3):
+            col[:] = j
+            for q in range(m):
+                coef[q] = -10.0 * gap[j, q] / h
+            _edge(gp, tri, rows, vec, length, col, coef)
+    # circumradius R = abc / (4 area): a hole in the coverage
+    wd = np.empty(m)
+    radius = np.empty(m)
+    for q in range(m):
+        cross = vec[q, 0, 0] * (-vec[q, 2, 1]) - vec[q, 0, 1] * (-vec[q, 2, 0])
+        area = 0.5 * abs(cross)
+        prod = length[q, 0] * length[q, 1] * length[q, 2]
+        radius[q] = min(prod / max(4.0 * area, 1e-300), 1e6 * h)
+        wd[q] = max(0.0, radius[q] - wide * h) / h
+    energy += numpy_sum(wd * wd)
+    for q in range(m):
+        t = rows[q]
+        a, b, c = tri[t, 0], tri[t, 1], tri[t, 2]
+        f = 2 * wd[q] / h
+        r = max(radius[q], 1e-300)
+        for d in range(2):
+            cen = (pts[a, d] + pts[b, d] + pts[c, d]) / 3.0
+            gp[a, d] += f * (pts[a, d] - cen) / r
+            gp[b, d] += f * (pts[b, d] - cen) / r
+            gp[c, d] += f * (pts[c, d] - cen) / r
+    return energy, gp, rho, rows

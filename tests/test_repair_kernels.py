@@ -1,0 +1,185 @@
+"""The repair's numba energy: bit for bit the numpy code it replaced (a
+sampling is a local search whose end can turn on a last bit), and its
+gradient the energy's derivative."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial import Delaunay
+
+from sr33.samplers._repair_kernels import energy_terms, numpy_sum
+from sr33.samplers.repair import GAP, SHORT, TARGET
+
+EDGES = np.array([[0, 1], [1, 2], [2, 0]])
+
+
+def numpy_energy(pts, of, tri, move, hold, anchor, judged, reach, h, wide):
+    """The repair's energy as numpy computed it before the kernel (stop 42's
+    ``repair._energy``, its per-point sums left to ``np.bincount``)."""
+    kind = of[tri]
+    real = kind >= 0
+    movable = real & move[np.maximum(kind, 0)]
+    tri = tri[(kind != -1).all(axis=1) & (real.all(axis=1) | movable.any(axis=1))]
+    tri = tri[(judged[np.maximum(of[tri], 0)] & (of[tri] >= 0)).any(axis=1)]
+    p = pts[tri]
+    vec = p[:, EDGES[:, 0]] - p[:, EDGES[:, 1]]
+    length = np.linalg.norm(vec, axis=2)
+    if reach > 0:
+        near = length.max(axis=1) <= reach
+        tri, p, vec, length = tri[near], p[near], vec[near], length[near]
+    order = np.argsort(length, axis=1, kind="stable")
+    rows = np.arange(tri.shape[0])
+    i2, i3 = order[:, 1], order[:, 2]
+    l2, l3 = length[rows, i2], length[rows, i3]
+    rho = l2 / l3
+    over = np.maximum(0.0, rho - TARGET)
+    energy = float((over**2).sum())
+    at, terms = [], []
+
+    def push(edge_col, coef):
+        a = tri[rows, EDGES[edge_col, 0]]
+        b = tri[rows, EDGES[edge_col, 1]]
+        unit = vec[rows, edge_col] / length[rows, edge_col][:, None]
+        at.extend((a, b))
+        terms.extend((coef[:, None] * unit, -coef[:, None] * unit))
+
+    push(i2, 2 * over / l3)
+    push(i3, -2 * over * l2 / l3**2)
+    short = np.maximum(0.0, SHORT * h - length) / h
+    energy += float((short**2).sum()) / 2.0
+    for col in range(3):
+        push(np.full(tri.shape[0], col), -short[:, col] / h)
+    ends = of[tri[:, EDGES]]
+    real_ends = ends >= 0
+    ids = np.maximum(ends, 0)
+    both = (real_ends & hold[ids]).all(axis=2) & ~(real_ends & anchor[ids]).all(axis=2)
+    if both.any():
+        gap = (
+            np.where(
+                both,
+                np.maximum(0.0, GAP[0] * h - length) - np.maximum(0.0, length - GAP[1] * h),
+                0.0,
+            )
+            / h
+        )
+        energy += 5.0 * float((gap**2).sum()) / 2.0
+        for col in range(3):
+            push(np.full(tri.shape[0], col), -10.0 * gap[:, col] / h)
+    cross = vec[:, 0, 0] * (-vec[:, 2, 1]) - vec[:, 0, 1] * (-vec[:, 2, 0])
+    area = 0.5 * np.abs(cross)
+    radius = np.minimum(length.prod(axis=1) / np.maximum(4.0 * area, 1e-300), 1e6 * h)
+    wd = np.maximum(0.0, radius - wide * h) / h
+    energy += float((wd**2).sum())
+    cen = p.mean(axis=1)
+    pull = (
+        (2 * wd / h)[:, None, None]
+        * (p - cen[:, None, :])
+        / np.maximum(radius, 1e-300)[:, None, None]
+    )
+    at.append(tri.ravel())
+    terms.append(pull.reshape(-1, 2))
+    index, values = np.concatenate(at), np.concatenate(terms)
+    gp = np.stack(
+        [np.bincount(index, weights=values[:, j], minlength=pts.shape[0]) for j in range(2)],
+        axis=1,
+    )
+    return energy, gp, rho, tri
+
+
+def problem(seed, n, ghosts, frames, spacing):
+    """A jittered lattice of ``spacing`` (h is 0.1; slivers, near-equilateral and
+    wide triangles, short edges) with sliding, anchored, fixed, ghost and
+    frame points, and its Delaunay triangles."""
+    rng = np.random.default_rng(seed)
+    side = int(np.ceil(np.sqrt(n + ghosts + frames)))
+    g = np.stack(np.meshgrid(np.arange(side), np.arange(side)), -1).reshape(-1, 2)
+    pts = (g[: n + ghosts + frames] + rng.uniform(-0.45, 0.45, (n + ghosts + frames, 2))) * spacing
+    of = np.r_[np.arange(n), np.full(ghosts, -1), np.full(frames, -2)]
+    pick = rng.permutation(pts.shape[0])  # ghosts and frame points anywhere among them
+    pts, of = pts[pick], of[pick]
+    move = rng.random(n) < 0.6
+    hold = ~move & (rng.random(n) < 0.7)
+    anchor = hold & (rng.random(n) < 0.3)
+    judged = rng.random(n) < 0.8
+    return pts, of, Delaunay(pts).simplices.astype(np.int64), move, hold, anchor, judged
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(3, 400),
+    ghosts=st.integers(0, 20),
+    frames=st.integers(0, 20),
+    reach=st.sampled_from([0.0, 0.1, 0.4]),
+    wide=st.sampled_from([1.0, 1.35]),
+    spacing=st.sampled_from([0.05, 0.1]),  # 0.05: most edges short, most gaps too small
+)
+def test_the_energy_is_the_numpy_energy_bit_for_bit(seed, n, ghosts, frames, reach, wide, spacing):
+    pts, of, tri, move, hold, anchor, judged = problem(seed, n, ghosts, frames, spacing)
+    h = 0.1
+    energy, gp, rho, rows = energy_terms(
+        pts, of, tri, move, hold, anchor, judged, reach, h, TARGET, SHORT, GAP[0], GAP[1], wide
+    )
+    e0, gp0, rho0, tri0 = numpy_energy(pts, of, tri, move, hold, anchor, judged, reach, h, wide)
+    assert np.array_equal(tri[rows], tri0)
+    assert rho.tobytes() == rho0.tobytes()
+    assert energy == e0  # the same float, not a close one
+    assert gp.tobytes() == gp0.tobytes()
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    values=st.lists(
+        st.floats(-1e6, 1e6, allow_nan=False, allow_subnormal=False), min_size=0, max_size=2000
+    ),
+    columns=st.sampled_from([1, 3]),
+)
+def test_numpy_sum_is_numpys_own(values, columns):
+    a = np.asarray(values, dtype=np.float64)
+    a = a[: a.size - a.size % columns].reshape(-1, columns)
+    assert numpy_sum(a) == float(a.sum())
+
+
+def test_the_gradient_is_the_energys_derivative_and_the_radius_term_pulls_inwards():
+    rng = np.random.default_rng(5)
+    g = np.stack(np.meshgrid(np.arange(6.0), np.arange(5.0)), axis=-1).reshape(-1, 2)
+    pts = g + rng.uniform(-0.35, 0.35, g.shape)
+    tri = Delaunay(pts).simplices.astype(np.int64)
+    n = pts.shape[0]
+    yes, no = np.ones(n, dtype=bool), np.zeros(n, dtype=bool)
+
+    def energy(p, wide=1e9, hold=no):
+        return energy_terms(
+            p, np.arange(n), tri, yes, hold, no, yes, 0.0, 1.0, TARGET, SHORT, *GAP, wide
+        )
+
+    # without the radius term (wide 1e9) and the gap term (no sliding
+    # samples) the gradient is the exact derivative
+    e, grad, rho, rows = energy(pts)
+    assert e > 0.0 and (rho > TARGET).any() and rows.size == tri.shape[0]
+    eps = 1e-7
+    numeric = np.zeros_like(grad)
+    for i in range(n):
+        for j in range(2):
+            up, down = pts.copy(), pts.copy()
+            up[i, j] += eps
+            down[i, j] -= eps
+            numeric[i, j] = (energy(up)[0] - energy(down)[0]) / (2 * eps)
+    np.testing.assert_allclose(grad, numeric, atol=1e-5)
+    # the gap term: two sliding samples 0.5 h apart (below GAP[0]) pushed
+    # apart with twice the term's derivative (its weight in the descent)
+    pair = np.array([[0.0, 0.0], [0.5, 0.0], [0.25, 0.6]])
+    three = np.ones(3, dtype=bool)
+    hold = np.array([True, True, False])
+    args = (np.array([[0, 1, 2]]), three, hold, ~three, three, 0.0, 1.0, TARGET, SHORT, *GAP)
+    e_hold, g_hold, _, _ = energy_terms(pair, np.arange(3), *args, 1e9)
+    e_free, g_free, _, _ = energy_terms(pair, np.arange(3), args[0], three, ~three, *args[3:], 1e9)
+    gap = GAP[0] - 0.5
+    assert e_hold - e_free == pytest.approx(5.0 * gap**2 / 2.0)
+    np.testing.assert_allclose((g_hold - g_free)[:2], [[10.0 * gap, 0.0], [-10.0 * gap, 0.0]])
+    # the radius term: a wide triangle's corners are pulled to its centroid
+    wide = np.array([[0.0, 0.0], [4.0, 0.0], [2.0, 0.5]])
+    e, g, _, _ = energy_terms(wide, np.arange(3), *args[:1], three, ~three, *args[3:], 1.0)
+    assert e > 0.0
+    assert ((g * (wide - wide.mean(axis=0))).sum(axis=1) > 0).all()  # descent moves inwards
