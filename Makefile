@@ -51,6 +51,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/run.py --data $(DATA) --out out/bench.json
 	$(BIN)/python bench/samplers_report.py --out out/samplers.json
 	$(BIN)/python bench/validators_bench.py
+	$(BIN)/python bench/perturbation.py --out out/perturbation.json
 
 # the installed versions, written back as the pins (after a deliberate upgrade)
 lock: $(STAMP)

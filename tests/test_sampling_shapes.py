@@ -668,6 +668,33 @@ def test_shapes_meet_condition_iii(checked, name):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=pytest.mark.xdist_group(n)) for n in ("hexagonal_prism", "fillet_box")],
+)
+def test_a_spacing_changed_in_its_last_bits_keeps_the_margin(name):
+    """The verdict must not hinge on the last bits (issue 23's margin, the
+    brief's determinism): the spacing times 1 +- 1e-12, far below anything
+    a model, a scanner or another machine could tell from h, still samples
+    with every ratio at or below 0.85.  Measured in stop 43
+    (``bench/perturbation.py``): these two moved by up to 0.011 (0.820 ->
+    0.822 and 0.831; fillet_box 0.830 -> 0.830 and 0.832); cutcube (0.846
+    -> 0.866 and 0.961), conebox (0.843 -> 0.853 and 0.855), star_prism
+    (0.829 -> 0.882 and 0.880) and wedge (0.825 -> 0.882 and 0.829) do not
+    keep it yet (block_two_holes 0.829 -> 0.848 both ways, cone 0.832 ->
+    0.845 one way): the repair's local search ends elsewhere once qhull
+    splits a lattice's exact ties differently (docs/sampler.md, stop 43)."""
+    from sr33.validators.conditions import sample_conditions
+
+    s = shapes.build(name)
+    for eps in (1e-12, -1e-12):
+        r = scan(s, spacing=s.default_spacing * (1.0 + eps))
+        rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+        assert np.isfinite(rep.worst_ratio).all()
+        assert rep.worst_ratio.max() <= 0.85, (eps, float(rep.worst_ratio.max()))
+
+
+@pytest.mark.slow
 def test_rings_round_a_pole_and_an_apex_are_repaired(sampled, checked):
     """The rings round the cone tip's ball's pole halve like a disk's, and
     where they halved 54 intrinsic Delaunay triangles broke Condition III-ii
