@@ -35,9 +35,9 @@ ROOT = Path(__file__).resolve().parents[1]
 MARGIN = 0.85  # issue 23's margin under sqrt(3)/2
 
 
-def run(name: str, eps: float) -> dict:
-    """One sampling of ``name`` at its default h times ``1 + eps``, checked."""
-    s = shapes.build(name)
+def run(s, eps: float) -> dict:
+    """One sampling of the library shape ``s`` at its default h times
+    ``1 + eps``, checked."""
     t0 = time.perf_counter()
     r = scan(s) if eps == 0.0 else scan(s, spacing=s.default_spacing * (1.0 + eps))
     seconds = time.perf_counter() - t0
@@ -63,7 +63,8 @@ def main(argv=None) -> int:
     eps = [0.0] + (args.eps if args.eps else [1e-12, -1e-12])
     report, flagged = {}, []
     for name in args.only or shapes.shape_names():
-        runs = [run(name, e) for e in eps]
+        s = shapes.build(name)
+        runs = [run(s, e) for e in eps]
         report[name] = runs
         verdicts = {r["at_margin"] == 0 for r in runs}
         flag = len(verdicts) > 1

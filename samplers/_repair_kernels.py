@@ -70,7 +70,7 @@ def _pairwise(a):
             task_lo[tasks + 1], task_n[tasks + 1] = lo + n2, n - n2
             task_lo[tasks + 2], task_n[tasks + 2] = lo, n2
             tasks += 3
-    return sums[0] if depth else 0.0
+    return sums[0]  # (an empty array is one block of 0, summing to 0.0)
 
 
 @njit(cache=True)
@@ -89,21 +89,18 @@ def _edge_sum(terms, by_row):
 @njit(cache=True)
 def _push(gp, tri, rows, vec, length, col, coef, far):
     """The gradient terms of one edge per triangle (``col`` (m,), an edge's
-    column: corners ``col`` and ``col + 1``), ``coef`` times its unit vector
-    at its first corner, all triangles in turn, then minus that at its
-    second (``far``: the order ``np.bincount`` saw them in)."""
-    m = rows.size
-    for k in range(m):
+    column: corners ``col`` and ``col + 1``): ``coef`` times its unit vector
+    at its first corner, or minus that at its second (``far``).  :func:`_edge`
+    makes both passes, all triangles in turn each: the order ``np.bincount``
+    saw them in."""
+    for k in range(rows.size):
         c = col[k]
         ux = vec[k, c, 0] / length[k, c]
         uy = vec[k, c, 1] / length[k, c]
-        v = tri[rows[k], c] if not far else tri[rows[k], (c + 1) % 3]
-        if not far:
-            gp[v, 0] += coef[k] * ux
-            gp[v, 1] += coef[k] * uy
-        else:
-            gp[v, 0] += -coef[k] * ux
-            gp[v, 1] += -coef[k] * uy
+        v = tri[rows[k], (c + 1) % 3 if far else c]
+        f = -coef[k] if far else coef[k]
+        gp[v, 0] += f * ux
+        gp[v, 1] += f * uy
 
 
 @njit(cache=True)
@@ -138,8 +135,12 @@ def energy_terms(
     """
     npts = pts.shape[0]
     gp = np.zeros((npts, 2))
+    # the triangles that count, with their edges (edge j runs from corner j
+    # to corner j + 1) and lengths
     m0 = tri.shape[0]
     rows = np.empty(m0, dtype=np.int64)
+    vec = np.empty((m0, 3, 2))
+    length = np.empty((m0, 3))
     m = 0
     for t in range(m0):
         ghost = False
@@ -154,33 +155,22 @@ def energy_terms(
                 real += 1
                 movable = movable or move[s]
                 seen = seen or judged[s]
-        if not ghost and seen and (real == 3 or movable):
-            rows[m] = t
-            m += 1
-    # edge j of a triangle runs from corner j to corner j + 1
-    vec = np.empty((m, 3, 2))
-    length = np.empty((m, 3))
-    near = np.empty(m, dtype=np.int64)
-    k = 0
-    for q in range(m):
-        t = rows[q]
+        if ghost or not seen or not (real == 3 or movable):
+            continue
         longest = 0.0
         for j in range(3):
             a, b = tri[t, j], tri[t, (j + 1) % 3]
             vx = pts[a, 0] - pts[b, 0]
             vy = pts[a, 1] - pts[b, 1]
-            vec[k, j, 0] = vx
-            vec[k, j, 1] = vy
-            length[k, j] = np.sqrt(vx * vx + vy * vy)
-            longest = max(longest, length[k, j])
+            vec[m, j, 0] = vx
+            vec[m, j, 1] = vy
+            length[m, j] = np.sqrt(vx * vx + vy * vy)
+            longest = max(longest, length[m, j])
         if reach > 0.0 and not longest <= reach:
             continue
-        near[k] = t
-        k += 1
-    rows = near[:k]
-    vec = vec[:k]
-    length = length[:k]
-    m = k
+        rows[m] = t
+        m += 1
+    rows, vec, length = rows[:m], vec[:m], length[:m]
     rho = np.empty(m)
     over = np.empty(m)
     i2 = np.empty(m, dtype=np.int64)

@@ -204,3 +204,83 @@ def naive_self_intersections(v: np.ndarray, t: np.ndarray) -> np.ndarray:
         cos = np.einsum("ij,ij->i", na, nb) / np.maximum(la * lb, 1e-300)
         hit[two[cos > 1 - 1e-12]] = True
     return np.stack([i[hit], j[hit]], axis=1).astype(np.int64)
+
+
+_EDGES = np.array([[0, 1], [1, 2], [2, 0]])
+
+
+def naive_repair_energy(
+    pts, of, tri, move, hold, anchor, judged, reach, h, wide, target, short_, gap
+):
+    """The boundary repair's energy, gradient, ratios and counted triangles as
+    numpy computed them before the numba kernel
+    (``sr33.samplers._repair_kernels.energy_terms``; stop 42's
+    ``repair._energy``, its per-point sums left to ``np.bincount``)."""
+    kind = of[tri]
+    real = kind >= 0
+    movable = real & move[np.maximum(kind, 0)]
+    tri = tri[(kind != -1).all(axis=1) & (real.all(axis=1) | movable.any(axis=1))]
+    tri = tri[(judged[np.maximum(of[tri], 0)] & (of[tri] >= 0)).any(axis=1)]
+    p = pts[tri]
+    vec = p[:, _EDGES[:, 0]] - p[:, _EDGES[:, 1]]
+    length = np.linalg.norm(vec, axis=2)
+    if reach > 0:
+        near = length.max(axis=1) <= reach
+        tri, p, vec, length = tri[near], p[near], vec[near], length[near]
+    order = np.argsort(length, axis=1, kind="stable")
+    rows = np.arange(tri.shape[0])
+    i2, i3 = order[:, 1], order[:, 2]
+    l2, l3 = length[rows, i2], length[rows, i3]
+    rho = l2 / l3
+    over = np.maximum(0.0, rho - target)
+    energy = float((over**2).sum())
+    at, terms = [], []
+
+    def push(edge_col, coef):
+        a = tri[rows, _EDGES[edge_col, 0]]
+        b = tri[rows, _EDGES[edge_col, 1]]
+        unit = vec[rows, edge_col] / length[rows, edge_col][:, None]
+        at.extend((a, b))
+        terms.extend((coef[:, None] * unit, -coef[:, None] * unit))
+
+    push(i2, 2 * over / l3)
+    push(i3, -2 * over * l2 / l3**2)
+    short = np.maximum(0.0, short_ * h - length) / h
+    energy += float((short**2).sum()) / 2.0
+    for col in range(3):
+        push(np.full(tri.shape[0], col), -short[:, col] / h)
+    ends = of[tri[:, _EDGES]]
+    real_ends = ends >= 0
+    ids = np.maximum(ends, 0)
+    both = (real_ends & hold[ids]).all(axis=2) & ~(real_ends & anchor[ids]).all(axis=2)
+    if both.any():
+        gap = (
+            np.where(
+                both,
+                np.maximum(0.0, gap[0] * h - length) - np.maximum(0.0, length - gap[1] * h),
+                0.0,
+            )
+            / h
+        )
+        energy += 5.0 * float((gap**2).sum()) / 2.0
+        for col in range(3):
+            push(np.full(tri.shape[0], col), -10.0 * gap[:, col] / h)
+    cross = vec[:, 0, 0] * (-vec[:, 2, 1]) - vec[:, 0, 1] * (-vec[:, 2, 0])
+    area = 0.5 * np.abs(cross)
+    radius = np.minimum(length.prod(axis=1) / np.maximum(4.0 * area, 1e-300), 1e6 * h)
+    wd = np.maximum(0.0, radius - wide * h) / h
+    energy += float((wd**2).sum())
+    cen = p.mean(axis=1)
+    pull = (
+        (2 * wd / h)[:, None, None]
+        * (p - cen[:, None, :])
+        / np.maximum(radius, 1e-300)[:, None, None]
+    )
+    at.append(tri.ravel())
+    terms.append(pull.reshape(-1, 2))
+    index, values = np.concatenate(at), np.concatenate(terms)
+    gp = np.stack(
+        [np.bincount(index, weights=values[:, j], minlength=pts.shape[0]) for j in range(2)],
+        axis=1,
+    )
+    return energy, gp, rho, tri

@@ -294,6 +294,17 @@ FOR_FEATURE = {
 }
 
 
+def moved(solid, angles, move):
+    """A generated model's rigid motion (the recipe's "turned [a, b, c] moved
+    [x, y, z]"): turned about the x, y and z axes by ``angles`` (degrees) in
+    turn, then moved by ``move``."""
+    import cadquery as cq
+
+    for axis, a in zip(((1, 0, 0), (0, 1, 0), (0, 0, 1)), angles):
+        solid = solid.rotate((0, 0, 0), axis, a)
+    return solid.translate(cq.Vector(*move))
+
+
 @st.composite
 def cad_models(draw, feature: str | None = None) -> CadModel:
     """A solid composed from primitives (box, cylinder, cone, frustum,
@@ -373,9 +384,7 @@ def cad_models(draw, feature: str | None = None) -> CadModel:
         done.add(op)
     angles = [draw(st.floats(-180, 180)) for _ in range(3)]
     move = [draw(st.floats(-5, 5)) for _ in range(3)]
-    for axis, a in zip(((1, 0, 0), (0, 1, 0), (0, 0, 1)), angles):
-        solid = solid.rotate((0, 0, 0), axis, a)
-    solid = solid.translate(cq.Vector(*move))
+    solid = moved(solid, angles, move)
     steps.append(f"turned {angles} moved {move}")
     recipe = "; ".join(steps)
     try:

@@ -30,7 +30,7 @@ from sr33.samplers.scanline import scan  # noqa: E402
 from sr33.validators.conditions import sample_conditions  # noqa: E402
 from tests import fuzzstats  # noqa: E402
 from tests.helpers import check_homeomorphism  # noqa: E402
-from tests.strategies import FEATURE_CLASSES, cad_models  # noqa: E402
+from tests.strategies import FEATURE_CLASSES, cad_models, moved  # noqa: E402
 
 DEEP = os.environ.get("HYPOTHESIS_PROFILE") == "deep"
 GENERATED_PER_CLASS = int(os.environ.get("GENERATED_PER_CLASS", "125"))
@@ -180,9 +180,7 @@ def _turned_cone(radius, height, angles, move):
     from sr33.samplers import shapes
 
     solid = cq.Solid.makeCone(radius, 0.0, height, pnt=cq.Vector(0, 0, -height / 2))
-    for axis, a in zip(((1, 0, 0), (0, 1, 0), (0, 0, 1)), angles):
-        solid = solid.rotate((0, 0, 0), axis, a)
-    return shapes.from_cad(solid.translate(cq.Vector(*move)), name="generated")
+    return shapes.from_cad(moved(solid, angles, move), name="generated")
 
 
 @pytest.mark.xfail(

@@ -10,81 +10,7 @@ from scipy.spatial import Delaunay
 
 from sr33.samplers._repair_kernels import energy_terms, numpy_sum
 from sr33.samplers.repair import GAP, SHORT, TARGET
-
-EDGES = np.array([[0, 1], [1, 2], [2, 0]])
-
-
-def numpy_energy(pts, of, tri, move, hold, anchor, judged, reach, h, wide):
-    """The repair's energy as numpy computed it before the kernel (stop 42's
-    ``repair._energy``, its per-point sums left to ``np.bincount``)."""
-    kind = of[tri]
-    real = kind >= 0
-    movable = real & move[np.maximum(kind, 0)]
-    tri = tri[(kind != -1).all(axis=1) & (real.all(axis=1) | movable.any(axis=1))]
-    tri = tri[(judged[np.maximum(of[tri], 0)] & (of[tri] >= 0)).any(axis=1)]
-    p = pts[tri]
-    vec = p[:, EDGES[:, 0]] - p[:, EDGES[:, 1]]
-    length = np.linalg.norm(vec, axis=2)
-    if reach > 0:
-        near = length.max(axis=1) <= reach
-        tri, p, vec, length = tri[near], p[near], vec[near], length[near]
-    order = np.argsort(length, axis=1, kind="stable")
-    rows = np.arange(tri.shape[0])
-    i2, i3 = order[:, 1], order[:, 2]
-    l2, l3 = length[rows, i2], length[rows, i3]
-    rho = l2 / l3
-    over = np.maximum(0.0, rho - TARGET)
-    energy = float((over**2).sum())
-    at, terms = [], []
-
-    def push(edge_col, coef):
-        a = tri[rows, EDGES[edge_col, 0]]
-        b = tri[rows, EDGES[edge_col, 1]]
-        unit = vec[rows, edge_col] / length[rows, edge_col][:, None]
-        at.extend((a, b))
-        terms.extend((coef[:, None] * unit, -coef[:, None] * unit))
-
-    push(i2, 2 * over / l3)
-    push(i3, -2 * over * l2 / l3**2)
-    short = np.maximum(0.0, SHORT * h - length) / h
-    energy += float((short**2).sum()) / 2.0
-    for col in range(3):
-        push(np.full(tri.shape[0], col), -short[:, col] / h)
-    ends = of[tri[:, EDGES]]
-    real_ends = ends >= 0
-    ids = np.maximum(ends, 0)
-    both = (real_ends & hold[ids]).all(axis=2) & ~(real_ends & anchor[ids]).all(axis=2)
-    if both.any():
-        gap = (
-            np.where(
-                both,
-                np.maximum(0.0, GAP[0] * h - length) - np.maximum(0.0, length - GAP[1] * h),
-                0.0,
-            )
-            / h
-        )
-        energy += 5.0 * float((gap**2).sum()) / 2.0
-        for col in range(3):
-            push(np.full(tri.shape[0], col), -10.0 * gap[:, col] / h)
-    cross = vec[:, 0, 0] * (-vec[:, 2, 1]) - vec[:, 0, 1] * (-vec[:, 2, 0])
-    area = 0.5 * np.abs(cross)
-    radius = np.minimum(length.prod(axis=1) / np.maximum(4.0 * area, 1e-300), 1e6 * h)
-    wd = np.maximum(0.0, radius - wide * h) / h
-    energy += float((wd**2).sum())
-    cen = p.mean(axis=1)
-    pull = (
-        (2 * wd / h)[:, None, None]
-        * (p - cen[:, None, :])
-        / np.maximum(radius, 1e-300)[:, None, None]
-    )
-    at.append(tri.ravel())
-    terms.append(pull.reshape(-1, 2))
-    index, values = np.concatenate(at), np.concatenate(terms)
-    gp = np.stack(
-        [np.bincount(index, weights=values[:, j], minlength=pts.shape[0]) for j in range(2)],
-        axis=1,
-    )
-    return energy, gp, rho, tri
+from tests.naive import naive_repair_energy
 
 
 def problem(seed, n, ghosts, frames, spacing):
@@ -121,7 +47,9 @@ def test_the_energy_is_the_numpy_energy_bit_for_bit(seed, n, ghosts, frames, rea
     energy, gp, rho, rows = energy_terms(
         pts, of, tri, move, hold, anchor, judged, reach, h, TARGET, SHORT, GAP[0], GAP[1], wide
     )
-    e0, gp0, rho0, tri0 = numpy_energy(pts, of, tri, move, hold, anchor, judged, reach, h, wide)
+    e0, gp0, rho0, tri0 = naive_repair_energy(
+        pts, of, tri, move, hold, anchor, judged, reach, h, wide, TARGET, SHORT, GAP
+    )
     assert np.array_equal(tri[rows], tri0)
     assert rho.tobytes() == rho0.tobytes()
     assert energy == e0  # the same float, not a close one
