@@ -23,6 +23,7 @@ from .graph import cycle_edges
 from .holes import HoleLoops, concat, crossing_faces, face_links, hole_loops, uncovered, unpinch
 from .jit import compile_notice
 from .mesh import edge_keys, self_intersections
+from .patches import stray_patches
 from .progress import Steps, log, notice
 from .rng import localized_rng
 from .selection import ExactReport
@@ -67,7 +68,9 @@ class Reconstruction:
         Samples whose neighbourhood's faces do not form a disk (see
         :class:`sr33.FaceSelection`; an indicator).
     coned_samples : (s,) int64
-        Samples attached by cones at the end (Section 5).
+        Samples attached at the end (Section 5): by cones, as the centre of
+        a ring face's fan, or inside the face they lie over
+        (:mod:`sr33.patches`).
     fallback_components : int
         Ambiguous components where the strict search failed; the greedy
         fallback and then the exact selection (:mod:`sr33.selection`)
@@ -236,32 +239,55 @@ def _optional_crossings(pts, tri: np.ndarray, optional: np.ndarray) -> np.ndarra
     return sub[hits]
 
 
-def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolerance: Tolerance):
+def _triangulate_with_loops(
+    pts, base: CycleSet, holes: HoleLoops | None, tolerance: Tolerance, edges: np.ndarray
+):
     """Triangulate the selection plus the boundary loops that stay valid.
 
-    A loop face is dropped when its triangles are not covered by the samples
-    or cross another triangle (:mod:`sr33.holes`); then a ring-centre fan
-    that crosses another triangle (a bevelled acute edge's sample under a
+    Faces ringing round clusters of stray samples are triangulated with them
+    (:mod:`sr33.patches`); a patch that crosses another triangle is undone
+    first.  A loop face is dropped when its triangles are not covered by the
+    samples or cross another triangle (:mod:`sr33.holes`); then a ring-centre
+    fan that crosses another triangle (a bevelled acute edge's sample under a
     quad) gives its sample back to the cones, which insert it where nothing
-    crosses.  Returns the faces, their triangulation, the centres used and
-    the number of loop faces kept, and the *flaps*: faces of ``base`` that a
-    dropped loop face crossed and that have two or more samples on that
-    loop (a face folded over the hole).
+    crosses.  Returns the faces, their triangulation, the centres and
+    patches used and the number of loop faces kept, and the *flaps*: faces
+    of ``base`` that a dropped loop face crossed and that have two or more
+    samples on that loop (a face folded over the hole).
     """
     nb = len(base)
     flaps: set[int] = set()
     loops = holes.loops if holes is not None else None
     active = list(range(len(loops))) if loops is not None else []
     no_centre: set[tuple[str, int]] = set()
+    no_patch: set[tuple[str, int]] = set()
     rounds = 0
     while True:
         faces = concat(base, loops.subset(np.array(active, dtype=np.int64))) if active else base
         key = [("f", i) for i in range(nb)] + [("l", i) for i in active]
-        centres = {f: c for f, c in ring_centres(pts, faces).items() if key[f] not in no_centre}
-        tr = triangulate(pts, faces, rtol=tolerance.rtol, centres=centres)
+        skip = {f for f in range(len(faces)) if key[f] in no_patch}
+        patches = stray_patches(pts, faces, edges, skip_faces=skip, min_interior=2)
+        placed = {int(v) for p in patches.values() for v in p.interior.tolist()}
+        centres = {
+            f: c
+            for f, c in ring_centres(pts, faces).items()
+            if key[f] not in no_centre and f not in patches and c not in placed
+        }
+        tr = triangulate(
+            pts,
+            faces,
+            rtol=tolerance.rtol,
+            centres=centres,
+            patches={f: p.triangles for f, p in patches.items()},
+        )
         fot = tr.face_of_triangle
-        hits = _optional_crossings(pts, tr.triangles, (fot >= nb) | np.isin(fot, list(centres)))
+        optional = (fot >= nb) | np.isin(fot, list(centres)) | np.isin(fot, list(patches))
+        hits = _optional_crossings(pts, tr.triangles, optional)
         crossing = set(fot[hits.ravel()].tolist())
+        if crossing & set(patches):
+            log.debug("stray patches: %d crossing, undone", len(crossing & set(patches)))
+            no_patch |= {key[f] for f in crossing & set(patches)}
+            continue
         drop = {f for f in crossing if f >= nb}
         for a, b in fot[hits].tolist():
             for lf, bf in ((a, b), (b, a)):
@@ -291,7 +317,7 @@ def _triangulate_with_loops(pts, base: CycleSet, holes: HoleLoops | None, tolera
         if not bad_centres or rounds > 3:
             break
         no_centre |= {key[f] for f in bad_centres}
-    return faces, tr, centres, len(active), flaps
+    return faces, tr, centres, patches, len(active), flaps
 
 
 def _piece_of_face(faces: CycleSet, n: int) -> np.ndarray:
@@ -308,6 +334,7 @@ def _close_holes(
     base: CycleSet,
     max_hole_length: int,
     tolerance: Tolerance,
+    edges: np.ndarray,
     grow: int = 6,
     everywhere: bool = True,
 ):
@@ -320,22 +347,24 @@ def _close_holes(
     ``grow`` times; pieces of the surface that removing flaps detaches are removed
     too (their samples go to the cones); the round with the fewest open
     edges plus pinched samples plus crossing faces (then the first) is kept.
-    Returns the faces, their triangulation, the centres, the number of
-    loop faces and the faces' figures.
+    Returns the faces, their triangulation, the centres, the patches
+    (:mod:`sr33.patches`), the number of loop faces and the faces' figures.
     """
     best, best_score = None, 0
     cur = base
     pieces = int(_piece_of_face(base, pts.shape[0]).max()) + 1 if len(base) else 0
     for _ in range(grow + 1):
         holes = hole_loops(pts, cur, max_length=max_hole_length) if max_hole_length else None
-        faces, tr, centres, n_loops, flaps = _triangulate_with_loops(pts, cur, holes, tolerance)
+        faces, tr, centres, patches, n_loops, flaps = _triangulate_with_loops(
+            pts, cur, holes, tolerance, edges
+        )
         figs = _figures(faces, pts.shape[0])
         folds = crossing_faces(
             pts, faces, tr.triangles, tr.face_of_triangle, len(cur), everywhere=everywhere
         )
         score = figs.defects + folds.shape[0]
         if best is None or score < best_score:
-            best, best_score = (faces, tr, centres, n_loops, figs), score
+            best, best_score = (faces, tr, centres, patches, n_loops, figs), score
         # the loops' base faces come first in ``faces``: unpinch on the base
         flaps |= set(unpinch(cur, pts.shape[0]).tolist())
         flaps |= set(folds.tolist())
@@ -380,6 +409,7 @@ class _Run:
     faces: CycleSet  # the selection's faces, loop faces after them
     triangulation: object  # Triangulation of ``faces``
     centres: dict
+    patches: dict  # face -> Patch (sr33.patches)
     loops: int
     figures: _Figures
     triangles: np.ndarray  # after the cones
@@ -435,21 +465,27 @@ def _pipeline(
         )
     with run.step("triangulate", timings):
         # a selection the strict search made alone is checked for folds only
-        faces, tr, centres, n_loops, figs = _close_holes(
-            pts, sel.faces, max_hole_length, tolerance, everywhere=sel.fallback_components > 0
+        faces, tr, centres, patches, n_loops, figs = _close_holes(
+            pts,
+            sel.faces,
+            max_hole_length,
+            tolerance,
+            rng.edges,
+            everywhere=sel.fallback_components > 0,
         )
         tri = tr.triangles
     if check:
         with run.step("self_checks", timings):
-            check_faces_and_triangles(faces, tri, tr.face_of_triangle, centres)
+            interiors = {f: p.interior.shape[0] for f, p in patches.items()}
+            check_faces_and_triangles(faces, tri, tr.face_of_triangle, centres, interiors)
     with run.step("cones", timings):
         if tri.shape[0]:
             tri, coned = attach_cones(pts, tri)
         else:
             coned = np.empty(0, dtype=np.int64)
     return _Run(
-        pts, uniq, first, inverse, dup, k, rng, cycles, sel, faces, tr, centres, n_loops, figs,
-        tri, coned,
+        pts, uniq, first, inverse, dup, k, rng, cycles, sel, faces, tr, centres, patches,
+        n_loops, figs, tri, coned,
     )  # fmt: skip
 
 
@@ -553,6 +589,7 @@ def _result(r: _Run, timings: dict[str, float]) -> Reconstruction:
         and not np.isin(now_open, bad_open).any()
     )
     open_edges = np.sort(relabel[still_open], axis=1) if still_open.size else still_open
+    attached = [r.coned, list(r.centres.values())] + [p.interior for p in r.patches.values()]
     faces = CycleSet(offsets=r.faces.offsets, vertices=relabel[r.faces.vertices])
     return Reconstruction(
         vertices=r.uniq[out_order],
@@ -567,7 +604,7 @@ def _result(r: _Run, timings: dict[str, float]) -> Reconstruction:
         open_edges=open_edges,
         unresolved_samples=np.sort(relabel[np.flatnonzero(~disk)]),
         non_disk_neighbourhoods=np.sort(relabel[sel.non_disk_neighbourhoods]),
-        coned_samples=np.sort(relabel[np.r_[r.coned, list(r.centres.values())].astype(np.int64)]),
+        coned_samples=np.sort(relabel[np.concatenate(attached).astype(np.int64)]),
         fallback_components=sel.fallback_components,
         hole_faces=r.loops,
         exact=sel.exact,

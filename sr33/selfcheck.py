@@ -32,9 +32,11 @@ def check_faces_and_triangles(
     triangles: np.ndarray,
     face_of_triangle: np.ndarray,
     centres: dict[int, int] | None = None,
+    interiors: dict[int, int] | None = None,
 ) -> None:
     """Edge use <= 2 in the faces and the triangles; L - 2 triangles per face
-    (L for a face coned from a centre sample); the triangles' Euler
+    (L for a face coned from a centre sample, L - 2 + 2 s for a face
+    patched with s samples inside it); the triangles' Euler
     characteristic equals the faces' (a cone adds one vertex, L edges and
     L - 1 faces: no change)."""
     if len(faces) == 0:
@@ -47,6 +49,8 @@ def check_faces_and_triangles(
     want = faces.lengths - 2
     for fi in centres or {}:
         want[fi] += 2
+    for fi, s in (interiors or {}).items():
+        want[fi] += 2 * s
     if not np.array_equal(per_face, want):
         raise InternalError("triangulate: a face did not become length - 2 triangles")
     tp = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])

@@ -143,7 +143,12 @@ def _triangulate_polygon(points, cyc, forbidden: set, rtol: float):
 
 
 def triangulate(
-    points, faces: CycleSet, *, rtol: float = 1e-9, centres: dict[int, int] | None = None
+    points,
+    faces: CycleSet,
+    *,
+    rtol: float = 1e-9,
+    centres: dict[int, int] | None = None,
+    patches: dict[int, np.ndarray] | None = None,
 ) -> Triangulation:
     """Triangulate(◇): line 4 of Algorithm 1, triangles with disjoint interiors.
 
@@ -160,6 +165,12 @@ def triangulate(
         cone tip the face cycle rings around).  Such a face becomes the cone
         of the paper's Section 5 from that sample: one triangle per cycle
         edge, instead of a triangulation across the ring.
+    patches : dict of int to (t, 3) int64, optional
+        Face index -> its triangles with the samples inside it
+        (:func:`sr33.patches.stray_patches`): a disk bounded by the cycle,
+        its triangles oriented alike.  They are taken as they are and
+        oriented with the face; their chords are kept off the other faces'
+        triangulations.
 
     Returns
     -------
@@ -195,6 +206,19 @@ def triangulate(
         tri_parts.append(fan.astype(np.int64))
         own_parts.append(np.full(cyc.shape[0], fi, dtype=np.int64))
         coned[fi] = True
+    chords = []
+    for fi, given in sorted((patches or {}).items()):
+        if not 0 <= fi < len(oriented) or coned[fi]:
+            raise InputError(f"patches names face {fi}: out of range or coned from a centre")
+        t = np.asarray(given, dtype=np.int64).reshape(-1, 3)
+        cyc = oriented.cycle(fi)
+        a, b = int(cyc[0]), int(cyc[1])
+        ahead = np.any((t == a) & (np.roll(t, -1, axis=1) == b))
+        t = t if ahead else t[:, ::-1]
+        tri_parts.append(t)
+        own_parts.append(np.full(t.shape[0], fi, dtype=np.int64))
+        chords.append(edge_keys(t, np.roll(t, -1, axis=1), n).ravel())
+        coned[fi] = True
     # triangles stay as they are
     t3 = np.flatnonzero((lengths == 3) & ~coned)
     if t3.shape[0]:
@@ -202,7 +226,7 @@ def triangulate(
         own_parts.append(t3)
     # quads, vectorized: the common case
     q4 = np.flatnonzero((lengths == 4) & ~coned)
-    face_keys = np.unique(edge_keys(pairs[:, 0], pairs[:, 1], n))
+    face_keys = np.unique(np.concatenate([edge_keys(pairs[:, 0], pairs[:, 1], n), *chords]))
     sequential = [int(i) for i in np.flatnonzero((lengths > 4) & ~coned)]
     if q4.shape[0]:
         q = oriented.vertices[oriented.offsets[q4][:, None] + np.arange(4)]
