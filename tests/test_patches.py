@@ -147,3 +147,17 @@ def test_triangulate_refuses_a_patch_for_a_face_out_of_range():
     faces = CycleSet(np.array([0, 6]), np.arange(6))
     with pytest.raises(Exception, match="patches names face 3"):
         triangulate(p, faces, patches={3: np.array([[0, 1, 2]])})
+
+
+def test_a_ring_that_is_not_convex_in_its_chart_keeps_only_the_triangles_inside_it():
+    # a ten-pointed star (radii 1 and 0.8) round three samples raised off its plane:
+    # the Delaunay triangles in its notches lie outside the ring and are not the patch's
+    ang = np.pi * np.arange(10) / 5
+    rad = np.where(np.arange(10) % 2, 0.8, 1.0)
+    ring = np.stack([rad * np.cos(ang), rad * np.sin(ang), np.zeros(10)], 1)
+    inner = np.array([[0.2, 0.1, 0.3], [-0.25, 0.05, 0.35], [0.0, -0.3, 0.25]])
+    p = np.vstack([ring, inner])
+    tri = chart_patch(p, np.arange(10), np.arange(10, 13))
+    assert tri is not None
+    assert tri.shape == (10 - 2 + 2 * 3, 3)
+    assert boundary_edges(tri) == {(min(i, (i + 1) % 10), max(i, (i + 1) % 10)) for i in range(10)}
