@@ -62,10 +62,17 @@ lock: $(STAMP)
 # the deep profile of the fuzz targets (file readers over mutated bytes,
 # messy point arrays; over 10,000 inputs) and of the properties, the
 # generated-model property at GENERATED_PER_CLASS (125) models per feature
-# class (1,000 models: hours); one file alone: make fuzz FUZZ=tests/test_fuzz.py
+# class (1,000 models: hours); one file alone: make fuzz FUZZ=tests/test_fuzz.py;
+# a survey of the generated models (no shrinking, failures listed with their
+# recipes, every class's shares): make fuzz FUZZ=tests/test_generated.py
+# FUZZ_SURVEY=1 GENERATED_PER_CLASS=4
 FUZZ ?= tests/test_fuzz.py tests/test_properties.py tests/test_generated.py
+FUZZ_SURVEY ?= 0
+GENERATED_PER_CLASS ?= 125
 fuzz: $(STAMP)
-	HYPOTHESIS_PROFILE=deep FUZZ_REPORT=1 $(BIN)/python -m pytest -q -p no:cacheprovider $(FUZZ)
+	HYPOTHESIS_PROFILE=deep FUZZ_REPORT=1 FUZZ_SURVEY=$(FUZZ_SURVEY) \
+	GENERATED_PER_CLASS=$(GENERATED_PER_CLASS) \
+	$(BIN)/python -m pytest -q -p no:cacheprovider $(FUZZ)
 
 # the optional comparison (Open3D ball pivoting and Poisson, CGAL advancing
 # front); Open3D's wheel needs the system library libusb-1.0

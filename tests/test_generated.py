@@ -20,7 +20,7 @@ import os
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 pytest.importorskip("cadquery")
@@ -33,6 +33,11 @@ from tests.helpers import check_homeomorphism  # noqa: E402
 from tests.strategies import FEATURE_CLASSES, cad_models, moved  # noqa: E402
 
 DEEP = os.environ.get("HYPOTHESIS_PROFILE") == "deep"
+#: a survey (``make fuzz FUZZ_SURVEY=1``): no shrinking, and a failing model is
+#: counted and listed with its recipe instead of ending its class's run, so
+#: that the report gives every class's shares (shrinking one failure took
+#: 744 s of stop 43's 30-minute survey)
+SURVEY = os.environ.get("FUZZ_SURVEY") == "1"
 GENERATED_PER_CLASS = int(os.environ.get("GENERATED_PER_CLASS", "125"))
 #: samples per generated model: small enough for the ci profile (a model's
 #: sampling, check and reconstruction take 10-30 s)
@@ -89,6 +94,7 @@ def guarantee(model, points: np.ndarray, spacing: float, rec) -> None:
     deadline=None,
     derandomize=not DEEP,
     suppress_health_check=list(HealthCheck),
+    phases=[p for p in Phase if p is not Phase.shrink] if SURVEY else list(Phase),
 )
 @given(data=st.data())
 def test_conforming_samplings_of_generated_models_reconstruct_homeomorphic(feature, data):
@@ -103,7 +109,13 @@ def test_conforming_samplings_of_generated_models_reconstruct_homeomorphic(featu
         return
     fuzzstats.count(f"conforming ({feature})")
     rec = reconstruct(r.points, 33)
-    guarantee(model, r.points, r.meta["spacing"], rec)
+    try:
+        guarantee(model, r.points, r.meta["spacing"], rec)
+    except AssertionError as err:
+        if not SURVEY:
+            raise
+        fuzzstats.reject(f"generated model ({feature}) FAILED: {model.recipe}: {err}")
+        return
     fuzzstats.count(f"homeomorphic ({feature})")
 
 
