@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
+from scipy.spatial import ConvexHull, QhullError
 
 from . import _intersect
 
@@ -349,6 +350,90 @@ def triangle_ratios(points, triangles) -> np.ndarray:
     length = np.sort(np.sqrt(((p - p[:, [1, 2, 0]]) ** 2).sum(axis=2)), axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         return length[:, 1] / length[:, 2]
+
+
+#: ties of :func:`delaunay_triangles` within this power distance (times the
+#: squared scale) are broken by the points' indices
+TIE_SLACK = 1e-6
+
+
+def _index_weights(n: int) -> np.ndarray:
+    """n numbers in [0, 1) that no linear relation among indices makes equal
+    (splitmix64 of the index): the tie-breaking weights of
+    :func:`delaunay_triangles`.  A linear rule (frac(i phi)) would not do: a
+    row-major lattice cell's corners i, i + m + 1 and i + 1, i + m have
+    equal sums."""
+    z = np.arange(n, dtype=np.uint64) + np.uint64(0x9E3779B97F4A7C15)
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    z = z ^ (z >> np.uint64(31))
+    return (z >> np.uint64(11)).astype(np.float64) / 2.0**53
+
+
+def delaunay_triangles(points, scale: float | None = None, *, slack: float = TIE_SLACK):
+    """Delaunay triangles of 2-D points, ties broken by a fixed rule.
+
+    A lattice's cells (rectangles; isosceles trapezoids between rings) have
+    their four corners on one circle, so either diagonal is Delaunay, and
+    which one qhull takes depends on the last bits of the coordinates (a
+    spacing changed by 1e-12 changes most of them).  Here the points are
+    lifted to the paraboloid ``|p - c|^2 / scale^2`` plus ``slack`` times a
+    weight fixed by each point's index (:func:`_index_weights`) and the
+    lower convex hull is taken: the regular triangulation for those
+    weights.  It is Delaunay wherever the empty-circle test decides by more
+    than ``slack`` (a power distance, in units of ``scale^2``); at a tie or
+    a near tie the diagonal is the one whose corners weigh less, the same
+    for any coordinates within rounding of the same points.
+
+    Parameters
+    ----------
+    points : (n, 2) array_like of float
+        The points (at least 3, not all on one line).
+    scale : float, optional
+        Their spacing; by default the side of a square cell per point over
+        their bounding box.
+    slack : float
+        The tie band, in units of ``scale^2``.  The rounding of the lifted
+        coordinates, about ``(R / scale)^2`` times 1e-16 for points spread
+        over R, must stay well below it (R up to 1e4 scale by default).
+
+    Returns
+    -------
+    (t, 3) int64
+        Counter-clockwise triangles, each starting at its smallest index,
+        rows sorted: one canonical array for one point set.  Raises
+        ``scipy.spatial.QhullError`` on degenerate input, as
+        ``scipy.spatial.Delaunay`` does.
+
+    Examples
+    --------
+    >>> square = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    >>> delaunay_triangles(square).tolist() == delaunay_triangles(
+    ...     np.array(square) * (1 + 1e-12)).tolist()
+    True
+    """
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    if scale is None:
+        ext = np.ptp(p, axis=0) if p.shape[0] else np.ones(2)
+        scale = float(np.sqrt(ext[0] * ext[1] / max(p.shape[0], 1))) or float(ext.max()) or 1.0
+    q = (p - p.mean(axis=0)) / scale
+    lifted = np.column_stack([q, (q * q).sum(axis=1) + slack * _index_weights(q.shape[0])])
+    if q.shape[0] == 3:  # too few for a hull in 3-D: one triangle, or a line
+        tri = np.arange(3, dtype=np.int64)[None]
+        e1, e2 = q[1] - q[0], q[2] - q[0]
+        if abs(e1[0] * e2[1] - e1[1] * e2[0]) <= 1e-12 * float((q * q).sum()):
+            raise QhullError("the three points are on one line")
+    else:
+        hull = ConvexHull(lifted)
+        # the lower hull; a facet within 1e-9 of vertical is a sliver of
+        # points (nearly) on one line of the 2-D hull's boundary: not a triangle
+        tri = hull.simplices[hull.equations[:, 2] < -1e-9].astype(np.int64)
+    a, b, c = q[tri[:, 0]], q[tri[:, 1]], q[tri[:, 2]]
+    turn = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    tri = np.where((turn < 0)[:, None], tri[:, [0, 2, 1]], tri)
+    first = np.argmin(tri, axis=1)
+    tri = np.take_along_axis(tri, (first[:, None] + np.arange(3)) % 3, axis=1)
+    return tri[np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))]
 
 
 def near_cocircular(points, triangles, slack: float) -> np.ndarray:

@@ -29,9 +29,10 @@ to the face's best-fit plane (the chart).  The patch is made when:
 
 The caller checks that the patch crosses no other triangle
 (:func:`sr33.reconstruct.reconstruct`).  The Delaunay triangulation is
-qhull's on the mapped samples in a fixed order (the cycle's, then the strays
-ascending), so the patch is deterministic; ties among cocircular mapped
-samples are split by qhull for that order.
+:func:`sr33.mesh.delaunay_triangles` of the mapped samples in a fixed order
+(the cycle's, then the strays ascending): ties among cocircular mapped
+samples (a cone's rings map to concentric circles, their cells to isosceles
+trapezoids) are split by that order, not by the coordinates' last bits.
 """
 
 from __future__ import annotations
@@ -41,11 +42,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
-from scipy.spatial import Delaunay, QhullError
+from scipy.spatial import QhullError
 
 from .cycles import CycleSet
 from .graph import cycle_edges
-from .mesh import edge_keys
+from .mesh import delaunay_triangles, edge_keys
 
 
 @dataclass(frozen=True)
@@ -182,13 +183,11 @@ def chart_patch(points, cycle, interior) -> np.ndarray | None:
     if not _inside(poly, flat, 1e-6 * size).all():
         return None
     allp = np.vstack([poly, flat])
+    side = float(np.mean(np.linalg.norm(nxt - poly, axis=1)))
     try:
-        dt = Delaunay(allp)
+        simp = delaunay_triangles(allp, side)
     except QhullError:
         return None
-    simp = np.asarray(dt.simplices, dtype=np.int64)
-    if dt.coplanar.shape[0]:
-        return None  # a sample qhull left out (numerically on another)
     cen = allp[simp].mean(axis=1)
     simp = simp[_inside(poly, cen, 0.0)]
     if simp.shape[0] != L - 2 + 2 * s:
@@ -203,13 +202,7 @@ def chart_patch(points, cycle, interior) -> np.ndarray | None:
     pos = np.minimum(pos, keys.shape[0] - 1)
     if not (np.array_equal(keys[pos], side_keys) and np.all(counts[pos] == 1)):
         return None
-    # counter-clockwise in the chart
-    p = allp[simp]
-    turn = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 1, 1] - p[:, 0, 1]) * (
-        p[:, 2, 0] - p[:, 0, 0]
-    )
-    simp = np.where((turn < 0)[:, None], simp[:, [0, 2, 1]], simp)
-    return np.concatenate([cyc, ins])[simp]
+    return np.concatenate([cyc, ins])[simp]  # counter-clockwise in the chart
 
 
 def stray_patches(

@@ -9,8 +9,10 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
+from scipy.spatial import Delaunay, QhullError
 
 from sr33.mesh import (
+    delaunay_triangles,
     dot,
     edge_incidence,
     edge_uses,
@@ -164,3 +166,63 @@ def test_closest_point_beats_a_dense_sampling_of_the_triangle(q):
 
 def test_unique_edges_sorts_each_pair():
     assert unique_edges([[3, 1], [1, 3], [0, 2]]).tolist() == [[0, 2], [1, 3]]
+
+
+# --- delaunay_triangles: ties broken by the indices, not the last bits --------
+
+
+def _lattices():
+    """A rectangular lattice (rows 0.8 apart) and rings of a disk (isosceles
+    trapezoids between them): every cell's corners on one circle."""
+    x, y = np.meshgrid(np.arange(12.0), 0.8 * np.arange(9.0))
+    rect = np.column_stack([x.ravel(), y.ravel()])
+    ang = 2 * np.pi * np.arange(24) / 24
+    rings = np.vstack([np.column_stack([r * np.cos(ang), r * np.sin(ang)]) for r in (1, 2, 3)])
+    return [rect, np.vstack([rings, [[0.0, 0.0]]])]
+
+
+@pytest.mark.parametrize("which", [0, 1], ids=["rectangles", "rings"])
+@given(
+    factor=st.floats(-1e-11, 1e-11),
+    shift=st.floats(-1e3, 1e3),
+    seed=st.integers(0, 2**16),
+)
+def test_delaunay_triangles_split_ties_the_same_under_rounding_changes(which, factor, shift, seed):
+    p = _lattices()[which]
+    want = delaunay_triangles(p, 1.0)
+    noise = np.random.default_rng(seed).uniform(-1e-13, 1e-13, p.shape) * max(1.0, abs(shift))
+    moved = (p * (1.0 + factor) + shift + noise) - shift
+    assert np.array_equal(delaunay_triangles(moved, 1.0), want)
+
+
+@given(seed=st.integers(0, 2**16), n=st.integers(3, 200))
+def test_delaunay_triangles_are_scipys_on_points_in_general_position(seed, n):
+    p = np.random.default_rng(seed).random((n, 2)) * 10.0
+    try:
+        theirs = Delaunay(p).simplices
+    except QhullError:
+        return
+    mine = delaunay_triangles(p)
+    assert {tuple(sorted(t)) for t in theirs.tolist()} == {tuple(sorted(t)) for t in mine.tolist()}
+
+
+@pytest.mark.parametrize("which", [0, 1], ids=["rectangles", "rings"])
+def test_delaunay_triangles_are_delaunay_ccw_and_canonical_on_ties(which):
+    p = _lattices()[which]
+    tri = delaunay_triangles(p, 1.0)
+    a, b, c = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
+    turn = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    assert (turn > 0).all()
+    assert (tri[:, 0] < tri[:, 1:].min(axis=1)).all()
+    assert np.array_equal(tri, tri[np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))])
+    # a triangulation of the hull: Euler's count, and every triangle's circle empty
+    assert tri.shape[0] == Delaunay(p).simplices.shape[0]
+    d = a - c
+    e = b - c
+    den = 2 * (d[:, 0] * e[:, 1] - d[:, 1] * e[:, 0])
+    ux = (e[:, 1] * (d * d).sum(1) - d[:, 1] * (e * e).sum(1)) / den
+    uy = (d[:, 0] * (e * e).sum(1) - e[:, 0] * (d * d).sum(1)) / den
+    centre = c + np.column_stack([ux, uy])
+    r2 = ux * ux + uy * uy
+    dist2 = ((p[None] - centre[:, None]) ** 2).sum(-1)
+    assert (dist2 >= r2[:, None] - 1e-9).all()
