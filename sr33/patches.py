@@ -14,9 +14,12 @@ becomes the patch of surface the strays sample.
 A cluster of strays is a connected component of the RNG restricted to the
 samples no face uses.  It belongs to a face when every sample the cluster's
 RNG edges reach outside it lies on that face's cycle (the cluster sits
-inside the ring; a cluster reaching two faces' samples sits across an edge,
-and the cones handle it).  The face's samples and its clusters are mapped
-to the face's best-fit plane (the chart).  The patch is made when:
+inside the ring), or to the faces whose samples it reaches all of, when
+those faces make one polygon with every sample on its boundary and the
+boundary holds every sample the cluster reaches (the ring closed by several
+faces).  A cluster reaching samples of faces round an edge sits across the
+edge, and the cones handle it.  The host's boundary and its clusters are
+mapped to the boundary's best-fit plane (the chart).  The patch is made when:
 
 * the cycle maps to a simple polygon and every stray maps strictly inside
   it (at least 1e-6 of the polygon's size from its sides): the patch is a
@@ -61,7 +64,9 @@ class Patch:
         The strays inside it, ascending.
     triangles : (L - 2 + 2s, 3) int64
         Its triangles, oriented alike (counter-clockwise in the chart); the
-        caller orients them with the face.
+        caller orients them with the face.  For a patch over several faces
+        (boundary of length L) the first face carries them, and the others
+        have none (and no interior).
     """
 
     face: int
@@ -205,6 +210,45 @@ def chart_patch(points, cycle, interior) -> np.ndarray | None:
     return np.concatenate([cyc, ins])[simp]  # counter-clockwise in the chart
 
 
+def _boundary_cycle(faces: CycleSet, ids: list[int]) -> np.ndarray | None:
+    """The boundary of the faces ``ids`` as one simple cycle, when their
+    union is a polygon bounded by it with no sample inside (every sample of
+    the faces on the boundary, every boundary sample on two boundary edges,
+    one loop); None otherwise."""
+    sub = faces.subset(np.asarray(ids, dtype=np.int64))
+    pairs, _ = cycle_edges(sub.offsets, sub.vertices)
+    und = np.sort(pairs, axis=1)
+    keys, counts = np.unique(und, axis=0, return_counts=True)
+    if counts.max() > 2:
+        return None
+    rim = keys[counts == 1]
+    verts = np.unique(sub.vertices)
+    if (
+        rim.shape[0] < 3
+        or np.unique(rim).shape[0] != rim.shape[0]
+        or verts.shape[0] != rim.shape[0]
+    ):
+        return None
+    nbr: dict[int, list[int]] = {}
+    for a, b in rim.tolist():
+        nbr.setdefault(a, []).append(b)
+        nbr.setdefault(b, []).append(a)
+    if any(len(v) != 2 for v in nbr.values()):
+        return None
+    start = int(rim.min())
+    cyc, prev, cur = [start], -1, start
+    while True:
+        a, b = nbr[cur]
+        nxt = b if a == prev else a
+        if nxt == start:
+            break
+        cyc.append(nxt)
+        prev, cur = cur, nxt
+    if len(cyc) != rim.shape[0]:
+        return None  # several loops: not a disk
+    return np.array(cyc, dtype=np.int64)
+
+
 def stray_patches(
     points,
     faces: CycleSet,
@@ -213,7 +257,14 @@ def stray_patches(
     skip_faces=(),
     min_interior: int = 1,
 ) -> dict[int, Patch]:
-    """The faces to re-triangulate with the stray clusters inside them.
+    """The faces to re-triangulate with the stray clusters over them.
+
+    A cluster's host is a face whose cycle holds every sample the cluster
+    reaches (the strays stand inside one ring), else the faces whose samples
+    the cluster reaches all of, when they make one polygon whose boundary
+    holds them all (a ring closed by several faces: a quad, a triangle and
+    a hexagon across a cone's ring, the strays above).  The host's boundary
+    is triangulated with the strays (:func:`chart_patch`).
 
     Parameters
     ----------
@@ -226,14 +277,15 @@ def stray_patches(
     skip_faces : iterable of int
         Faces not to patch (whose patch crossed another triangle).
     min_interior : int
-        Fewest strays a face must ring round to be patched (a face round
-        one stray is left to :func:`sr33.cones.ring_centres`).
+        Fewest strays a host must have to be patched (a face round one
+        stray is left to :func:`sr33.cones.ring_centres`).
 
     Returns
     -------
     dict of int to Patch
-        Face index -> its patch, for the faces whose conditions (module
-        docstring) hold.
+        Face index -> its patch.  A patch over several faces is given to
+        the first of them with an edge on the boundary; the others map to a
+        patch with no triangles (they are replaced by the first's).
     """
     pts = np.asarray(points, dtype=np.float64)
     n = pts.shape[0]
@@ -250,44 +302,78 @@ def stray_patches(
     order = np.lexsort((owner, faces.vertices))
     fv, fo = faces.vertices[order], owner[order]
     starts = np.searchsorted(fv, np.arange(n + 1))
-    hosts: dict[int, list[int]] = {}
+    pairs, pair_owner = cycle_edges(faces.offsets, faces.vertices)
+    face_keys = edge_keys(pairs[:, 0], pairs[:, 1], n)
+    # hosts: (faces replaced, boundary cycle) -> clusters, in order of first cluster
+    hosts: dict[tuple[int, ...], list[int]] = {}
     for ci, r in enumerate(reach):
-        if r.shape[0] == 0:
+        if r.shape[0] == 0 or clusters[ci].shape[0] == 0:
             continue
+        rl = r.tolist()
         common = None
-        for v in r.tolist():
+        for v in rl:
             here = set(fo[starts[v] : starts[v + 1]].tolist())
             common = here if common is None else common & here
             if not common:
                 break
-        for f in sorted(common or ()):
-            if f not in skip:
-                hosts.setdefault(f, []).append(ci)
-    pairs, _ = cycle_edges(faces.offsets, faces.vertices)
-    face_keys = edge_keys(pairs.min(axis=1), pairs.max(axis=1), n)
+        single = [(f,) for f in sorted(common or ()) if f not in skip]
+        if single:
+            for key in single:
+                hosts.setdefault(key, []).append(ci)
+            continue
+        # faces with every sample among those the cluster reaches
+        near = sorted(
+            set(fo[np.concatenate([np.arange(starts[v], starts[v + 1]) for v in rl])].tolist())
+        )
+        inside_r = [f for f in near if np.isin(faces.cycle(f), r).all()]
+        if len(inside_r) >= 2 and not skip.intersection(inside_r):
+            hosts.setdefault(tuple(inside_r), []).append(ci)
     chords: list[np.ndarray] = []
     taken: set[int] = set()
+    replaced: set[int] = set()
     out: dict[int, Patch] = {}
-    for f in sorted(hosts):
-        cis = [ci for ci in hosts[f] if ci not in taken]
+    for host in sorted(hosts, key=lambda k: (min(hosts[k]), k)):
+        if replaced.intersection(host):
+            continue
+        cis = [ci for ci in hosts[host] if ci not in taken]
         if not cis:
             continue
         ins = np.sort(np.concatenate([clusters[ci] for ci in cis]))
         if ins.shape[0] < min_interior:
             continue
-        cyc = faces.cycle(f)
+        cyc = faces.cycle(host[0]) if len(host) == 1 else _boundary_cycle(faces, list(host))
+        if (
+            cyc is None
+            or not np.isin(np.unique(np.concatenate([reach[ci] for ci in cis])), cyc).all()
+        ):
+            continue
         tri = chart_patch(pts, cyc, ins)
         if tri is None:
             continue
-        # chords between two cycle samples must not be another face's edge
+        # chords between two boundary samples must not be an edge of a face
+        # outside the host (it would be used three times), nor another patch's
         on = np.isin(tri, cyc)
         tk = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
         chord = np.concatenate([on[:, [0, 1]], on[:, [1, 2]], on[:, [2, 0]]]).all(axis=1)
-        ck = edge_keys(tk[chord].min(axis=1), tk[chord].max(axis=1), n)
-        mine = edge_keys(np.minimum(cyc, np.roll(cyc, -1)), np.maximum(cyc, np.roll(cyc, -1)), n)
-        if np.isin(np.setdiff1d(ck, mine), np.concatenate([face_keys, *chords])).any():
+        mine = edge_keys(cyc, np.roll(cyc, -1), n)
+        ck = np.setdiff1d(edge_keys(tk[chord, 0], tk[chord, 1], n), mine)
+        outside = face_keys[~np.isin(pair_owner, host)]
+        if np.isin(ck, np.concatenate([outside, *chords])).any():
             continue
-        chords.append(np.setdiff1d(ck, mine))
+        chords.append(ck)
         taken.update(cis)
-        out[f] = Patch(face=int(f), interior=ins, triangles=tri)
+        replaced.update(host)
+        # the patch goes to the first face with an edge on the boundary (its
+        # orientation orients the patch); the others give up their triangles
+        first = next(
+            f
+            for f in host
+            if np.isin(edge_keys(faces.cycle(f), np.roll(faces.cycle(f), -1), n), mine).any()
+        )
+        for f in host:
+            out[f] = Patch(
+                face=int(f),
+                interior=ins if f == first else np.empty(0, np.int64),
+                triangles=tri if f == first else np.empty((0, 3), np.int64),
+            )
     return out

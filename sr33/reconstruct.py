@@ -329,6 +329,36 @@ def _piece_of_face(faces: CycleSet, n: int) -> np.ndarray:
     return np.unique(first, return_inverse=True)[1].reshape(-1)
 
 
+def _without_small_open_pieces(faces: CycleSet, n: int, share: float = 0.05) -> CycleSet:
+    """The faces without the small open pieces of the surface.
+
+    A piece other than the largest, with open edges and fewer than
+    ``share`` of the faces, is a bit the selection cut off (a cone's tip
+    closed apart from the ring round it, both left open): its samples are
+    better placed as strays (:mod:`sr33.patches`, the cones) into the hole
+    it leaves.  A closed piece (a second body) and the largest piece (a
+    sheet with a true boundary) stay.
+    """
+    if len(faces) == 0:
+        return faces
+    lab = _piece_of_face(faces, n)
+    size = np.bincount(lab)
+    if size.shape[0] < 2:
+        return faces
+    pairs, owner = cycle_edges(faces.offsets, faces.vertices)
+    keys = edge_keys(pairs[:, 0], pairs[:, 1], n)
+    _, inv, cnt = np.unique(keys, return_inverse=True, return_counts=True)
+    open_piece = np.zeros(size.shape[0], dtype=bool)
+    open_piece[lab[owner[cnt[inv] == 1]]] = True
+    largest = int(np.argmax(size))
+    small = open_piece & (size < share * len(faces))
+    small[largest] = False
+    if not small.any():
+        return faces
+    log.debug("hole loops: %d small open pieces taken apart", int(small.sum()))
+    return faces.subset(~small[lab])
+
+
 def _close_holes(
     pts,
     base: CycleSet,
@@ -351,8 +381,8 @@ def _close_holes(
     (:mod:`sr33.patches`), the number of loop faces and the faces' figures.
     """
     best, best_score = None, 0
-    cur = base
-    pieces = int(_piece_of_face(base, pts.shape[0]).max()) + 1 if len(base) else 0
+    cur = _without_small_open_pieces(base, pts.shape[0])
+    pieces = int(_piece_of_face(cur, pts.shape[0]).max()) + 1 if len(cur) else 0
     for _ in range(grow + 1):
         holes = hole_loops(pts, cur, max_length=max_hole_length) if max_hole_length else None
         faces, tr, centres, patches, n_loops, flaps = _triangulate_with_loops(
@@ -476,8 +506,8 @@ def _pipeline(
         tri = tr.triangles
     if check:
         with run.step("self_checks", timings):
-            interiors = {f: p.interior.shape[0] for f, p in patches.items()}
-            check_faces_and_triangles(faces, tri, tr.face_of_triangle, centres, interiors)
+            counts = {f: p.triangles.shape[0] for f, p in patches.items()}
+            check_faces_and_triangles(faces, tri, tr.face_of_triangle, centres, counts)
     with run.step("cones", timings):
         if tri.shape[0]:
             tri, coned = attach_cones(pts, tri)

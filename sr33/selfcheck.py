@@ -32,11 +32,11 @@ def check_faces_and_triangles(
     triangles: np.ndarray,
     face_of_triangle: np.ndarray,
     centres: dict[int, int] | None = None,
-    interiors: dict[int, int] | None = None,
+    patched: dict[int, int] | None = None,
 ) -> None:
     """Edge use <= 2 in the faces and the triangles; L - 2 triangles per face
-    (L for a face coned from a centre sample, L - 2 + 2 s for a face
-    patched with s samples inside it); the triangles' Euler
+    (L for a face coned from a centre sample; for a patched face, the
+    count its patch gives, ``patched``); the triangles' Euler
     characteristic equals the faces' (a cone adds one vertex, L edges and
     L - 1 faces: no change)."""
     if len(faces) == 0:
@@ -49,8 +49,8 @@ def check_faces_and_triangles(
     want = faces.lengths - 2
     for fi in centres or {}:
         want[fi] += 2
-    for fi, s in (interiors or {}).items():
-        want[fi] += 2 * s
+    for fi, count in (patched or {}).items():
+        want[fi] = count
     if not np.array_equal(per_face, want):
         raise InternalError("triangulate: a face did not become length - 2 triangles")
     tp = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])

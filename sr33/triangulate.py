@@ -167,10 +167,11 @@ def triangulate(
         edge, instead of a triangulation across the ring.
     patches : dict of int to (t, 3) int64, optional
         Face index -> its triangles with the samples inside it
-        (:func:`sr33.patches.stray_patches`): a disk bounded by the cycle,
-        its triangles oriented alike.  They are taken as they are and
-        oriented with the face; their chords are kept off the other faces'
-        triangulations.
+        (:func:`sr33.patches.stray_patches`): a disk bounded by the cycle
+        (or by the boundary of several faces: the others map to no
+        triangles), its triangles oriented alike.  They are taken as they
+        are and oriented with the face; their chords are kept off the other
+        faces' triangulations.
 
     Returns
     -------
@@ -211,14 +212,24 @@ def triangulate(
         if not 0 <= fi < len(oriented) or coned[fi]:
             raise InputError(f"patches names face {fi}: out of range or coned from a centre")
         t = np.asarray(given, dtype=np.int64).reshape(-1, 3)
+        coned[fi] = True
+        if t.shape[0] == 0:
+            continue  # a face whose patch another face of its polygon carries
+        # oriented by the first of the face's edges on the patch's boundary
         cyc = oriented.cycle(fi)
-        a, b = int(cyc[0]), int(cyc[1])
-        ahead = np.any((t == a) & (np.roll(t, -1, axis=1) == b))
+        ahead = None
+        for a, b in zip(cyc.tolist(), np.roll(cyc, -1).tolist()):
+            fwd = np.any((t == a) & (np.roll(t, -1, axis=1) == b))
+            back = np.any((t == b) & (np.roll(t, -1, axis=1) == a))
+            if fwd != back:
+                ahead = bool(fwd)
+                break
+        if ahead is None:
+            raise InputError(f"patches gives face {fi} triangles on none of its edges")
         t = t if ahead else t[:, ::-1]
         tri_parts.append(t)
         own_parts.append(np.full(t.shape[0], fi, dtype=np.int64))
         chords.append(edge_keys(t, np.roll(t, -1, axis=1), n).ravel())
-        coned[fi] = True
     # triangles stay as they are
     t3 = np.flatnonzero((lengths == 3) & ~coned)
     if t3.shape[0]:

@@ -161,3 +161,36 @@ def test_a_ring_that_is_not_convex_in_its_chart_keeps_only_the_triangles_inside_
     assert tri is not None
     assert tri.shape == (10 - 2 + 2 * 3, 3)
     assert boundary_edges(tri) == {(min(i, (i + 1) % 10), max(i, (i + 1) % 10)) for i in range(10)}
+
+
+def test_a_ring_closed_by_several_faces_is_patched_as_their_polygon():
+    # the tip's ring of 8 closed by two faces (split by the chord 0-4) and a
+    # band below it; the strays reach every sample of the ring
+    p = cone_tip(4, 3, 0.35, 0.2)
+    pts, band = _tip_faces(p, 4)
+    cycles = [[0, 1, 2, 3, 4], [0, 4, 5, 6, 7]] + [band.cycle(i).tolist() for i in range(1, 9)]
+    offsets = np.r_[0, np.cumsum([len(c) for c in cycles])].astype(np.int64)
+    faces = CycleSet(offsets, np.array([v for c in cycles for v in c], dtype=np.int64))
+    ins = np.arange(8, p.shape[0])
+    chain = np.stack([ins[:-1], ins[1:]], 1)
+    reach = np.array([[8 + i % 4, i] for i in range(8)])
+    got = stray_patches(pts, faces, np.vstack([chain, reach]), min_interior=2)
+    assert sorted(got) == [0, 1]
+    carrier = [f for f in got if got[f].triangles.shape[0]]
+    assert len(carrier) == 1 and got[carrier[0]].interior.tolist() == ins.tolist()
+    patch = got[carrier[0]].triangles
+    assert patch.shape == (8 - 2 + 2 * ins.shape[0], 3)
+    assert boundary_edges(patch) == {(min(i, (i + 1) % 8), max(i, (i + 1) % 8)) for i in range(8)}
+    tr = triangulate(pts, faces, patches={f: q.triangles for f, q in got.items()})
+    tri = tr.triangles
+    half = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    assert np.unique(half, axis=0).shape[0] == half.shape[0]  # one orientation
+    e = np.unique(np.sort(half, axis=1), axis=0)
+    assert np.unique(tri).shape[0] - e.shape[0] + tri.shape[0] == 1  # a disk
+    # a cluster that also reaches a sample of the band below is not placed
+    off = np.vstack([chain, reach, [[ins[0], p.shape[0]]]])
+    assert stray_patches(pts, faces, off, min_interior=2) == {}
+    # nor when a face of the polygon is skipped (its patch crossed something)
+    assert (
+        stray_patches(pts, faces, np.vstack([chain, reach]), skip_faces=[1], min_interior=2) == {}
+    )
