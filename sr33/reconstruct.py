@@ -375,13 +375,14 @@ def _close_holes(
     where two faces of the selection cross (:func:`sr33.holes.crossing_faces`),
     those faces are removed and the larger hole's loop is tried instead, up to
     ``grow`` times; pieces of the surface that removing flaps detaches are removed
-    too (their samples go to the cones); the round with the fewest open
+    too (their samples go to the cones), and so are small open pieces from
+    the start (:func:`_without_small_open_pieces`); the round with the fewest open
     edges plus pinched samples plus crossing faces (then the first) is kept.
     Returns the faces, their triangulation, the centres, the patches
     (:mod:`sr33.patches`), the number of loop faces and the faces' figures.
     """
     best, best_score = None, 0
-    cur = _without_small_open_pieces(base, pts.shape[0])
+    cur = _without_small_open_pieces(base, pts.shape[0]) if max_hole_length else base
     pieces = int(_piece_of_face(cur, pts.shape[0]).max()) + 1 if len(cur) else 0
     for _ in range(grow + 1):
         holes = hole_loops(pts, cur, max_length=max_hole_length) if max_hole_length else None
