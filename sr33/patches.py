@@ -304,11 +304,11 @@ def stray_patches(
     starts = np.searchsorted(fv, np.arange(n + 1))
     pairs, pair_owner = cycle_edges(faces.offsets, faces.vertices)
     face_keys = edge_keys(pairs[:, 0], pairs[:, 1], n)
-    # hosts: (faces replaced, boundary cycle) -> clusters, in order of first cluster
+    # host (the faces a patch replaces) -> its clusters
     hosts: dict[tuple[int, ...], list[int]] = {}
     for ci, r in enumerate(reach):
-        if r.shape[0] == 0 or clusters[ci].shape[0] == 0:
-            continue
+        if r.shape[0] == 0:
+            continue  # a cluster reaching no used sample: the cones place it
         rl = r.tolist()
         common = None
         for v in rl:
