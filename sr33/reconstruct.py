@@ -505,6 +505,14 @@ def _pipeline(
             everywhere=sel.fallback_components > 0,
         )
         tri = tr.triangles
+        if patches:
+            carriers = [p for p in patches.values() if p.triangles.shape[0]]
+            log.debug(
+                "stray patches: %d over %d faces, %d strays placed",
+                len(carriers),
+                len(patches),
+                sum(p.interior.shape[0] for p in carriers),
+            )
     if check:
         with run.step("self_checks", timings):
             counts = {f: p.triangles.shape[0] for f, p in patches.items()}
