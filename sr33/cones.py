@@ -59,9 +59,7 @@ def ring_centres(points, faces) -> dict[int, int]:
     n = pts.shape[0]
     if len(faces) == 0:
         return {}
-    used = np.zeros(n, dtype=bool)
-    used[faces.vertices] = True
-    strays = np.flatnonzero(~used)
+    strays = np.flatnonzero(~faces.used(n))
     if strays.shape[0] == 0:
         return {}
     lengths = faces.lengths

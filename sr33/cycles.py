@@ -48,6 +48,12 @@ class CycleSet:
         """(c,) int64 number of vertices of every cycle."""
         return np.diff(self.offsets)
 
+    def used(self, n: int) -> np.ndarray:
+        """(n,) bool: which of ``n`` samples some cycle passes through."""
+        out = np.zeros(n, dtype=bool)
+        out[self.vertices] = True
+        return out
+
     def cycle(self, i: int) -> np.ndarray:
         """The vertices of cycle ``i`` in order."""
         return self.vertices[self.offsets[i] : self.offsets[i + 1]]

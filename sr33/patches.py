@@ -291,9 +291,7 @@ def stray_patches(
     n = pts.shape[0]
     if len(faces) == 0:
         return {}
-    used = np.zeros(n, dtype=bool)
-    used[faces.vertices] = True
-    clusters, reach = stray_clusters(n, used, edges)
+    clusters, reach = stray_clusters(n, faces.used(n), edges)
     if not clusters:
         return {}
     skip = set(int(f) for f in skip_faces)
