@@ -23,7 +23,7 @@ from .graph import cycle_edges
 from .holes import HoleLoops, concat, crossing_faces, face_links, hole_loops, uncovered, unpinch
 from .jit import compile_notice
 from .mesh import edge_keys, self_intersections
-from .patches import stray_patches
+from .patches import stray_clusters, stray_patches
 from .progress import Steps, log, notice
 from .rng import localized_rng
 from .selection import ExactReport
@@ -329,15 +329,20 @@ def _piece_of_face(faces: CycleSet, n: int) -> np.ndarray:
     return np.unique(first, return_inverse=True)[1].reshape(-1)
 
 
-def _without_small_open_pieces(faces: CycleSet, n: int, share: float = 0.05) -> CycleSet:
+def _without_small_open_pieces(
+    faces: CycleSet, n: int, edges: np.ndarray, share: float = 0.05
+) -> CycleSet:
     """The faces without the small open pieces of the surface.
 
     A piece other than the largest, with open edges and fewer than
-    ``share`` of the faces, is a bit the selection cut off (a cone's tip
-    closed apart from the ring round it, both left open): its samples are
-    better placed as strays (:mod:`sr33.patches`, the cones) into the hole
-    it leaves.  A closed piece (a second body) and the largest piece (a
-    sheet with a true boundary) stay.
+    ``share`` of the faces, whose boundary an RNG edge joins to another
+    piece (directly or through a cluster of strays), is a bit the selection
+    cut off (a cone's tip closed
+    apart from the ring round it, both left open): its samples are better
+    placed as strays (:mod:`sr33.patches`, the cones) into the hole it
+    leaves.  A closed piece (a second body), an open piece whose boundary no
+    RNG edge joins to another piece (a separate sheet) and the largest piece
+    (a sheet with a true boundary) stay.
     """
     if len(faces) == 0:
         return faces
@@ -348,10 +353,24 @@ def _without_small_open_pieces(faces: CycleSet, n: int, share: float = 0.05) -> 
     pairs, owner = cycle_edges(faces.offsets, faces.vertices)
     keys = edge_keys(pairs[:, 0], pairs[:, 1], n)
     _, inv, cnt = np.unique(keys, return_inverse=True, return_counts=True)
-    open_piece = np.zeros(size.shape[0], dtype=bool)
-    open_piece[lab[owner[cnt[inv] == 1]]] = True
+    # the piece of every sample, and of every sample on an open edge (-1 elsewhere)
+    piece = np.full(n, -1, dtype=np.int64)
+    piece[faces.vertices] = np.repeat(lab, faces.lengths)
+    rim_piece = np.full(n, -1, dtype=np.int64)
+    once = cnt[inv] == 1
+    rim_piece[pairs[once].ravel()] = np.repeat(lab[owner[once]], 2)
+    e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    facing = np.zeros(size.shape[0], dtype=bool)
+    for u, v in ((e[:, 0], e[:, 1]), (e[:, 1], e[:, 0])):
+        r, p = rim_piece[u], piece[v]
+        facing[r[(r >= 0) & (p >= 0) & (r != p)]] = True
+    # ... or through a cluster of strays reaching both
+    for reach in stray_clusters(n, piece >= 0, e)[1]:
+        rims = np.unique(rim_piece[reach])
+        if np.unique(piece[reach]).shape[0] > 1:
+            facing[rims[rims >= 0]] = True
     largest = int(np.argmax(size))
-    small = open_piece & (size < share * len(faces))
+    small = facing & (size < share * len(faces))
     small[largest] = False
     if not small.any():
         return faces
@@ -382,7 +401,7 @@ def _close_holes(
     (:mod:`sr33.patches`), the number of loop faces and the faces' figures.
     """
     best, best_score = None, 0
-    cur = _without_small_open_pieces(base, pts.shape[0]) if max_hole_length else base
+    cur = _without_small_open_pieces(base, pts.shape[0], edges) if max_hole_length else base
     pieces = int(_piece_of_face(cur, pts.shape[0]).max()) + 1 if len(cur) else 0
     for _ in range(grow + 1):
         holes = hole_loops(pts, cur, max_length=max_hole_length) if max_hole_length else None

@@ -137,3 +137,21 @@ def test_output_bytes_do_not_depend_on_thread_counts():
         )
         out.append(res.stdout.split())
     assert out[0] == out[1] and int(out[0][1]) > 0
+
+
+def test_a_separate_small_open_sheet_stays_apart_from_a_closed_body():
+    """A small open piece is taken apart into strays only when the RNG joins
+    its boundary to another piece (a tip cut off its cone): a sheet scanned
+    apart from a ball keeps its own triangles, none joins it to the ball."""
+    i = np.arange(900) + 0.5
+    z = 1 - 2 * i / 900
+    t = np.pi * (1 + 5**0.5) * i
+    ball = np.column_stack([np.sqrt(1 - z * z) * np.cos(t), np.sqrt(1 - z * z) * np.sin(t), z])
+    g = 0.12 * np.arange(6)
+    sheet = np.column_stack([np.repeat(g, 6), np.tile(g, 6), np.full(36, 4.0)])
+    r = reconstruct(np.vstack([ball, sheet]), 20)
+    in_sheet = np.isin(r.triangles, np.arange(900, 936))
+    assert not (in_sheet.any(axis=1) & ~in_sheet.all(axis=1)).any()  # no triangle joins them
+    assert np.unique(r.triangles[in_sheet.all(axis=1)]).shape[0] == 36
+    s = mesh_stats(r.triangles[in_sheet.all(axis=1)], r.vertices.shape[0])
+    assert s.open_edges == 20  # the sheet's own boundary
