@@ -89,7 +89,9 @@ def _generated_report(tr) -> None:
         secs = sum(r[1] for r in rows)
         share = f"{conf} ({100 * conf / drawn:.0f}%)" if drawn else "0"
         ok = f"{homeo} ({100 * homeo / conf:.0f}%)" if conf else "-"
-        flag = "yes" if failed or homeo < conf else "-"  # a survey lists, not raises
+        # a survey lists failures and checks that could not judge, not raises
+        crashed = any(k.startswith(f"{tag}{c}) CHECK FAILED") for k in REJECTED)
+        flag = "yes" if failed or homeo < conf or crashed else "-"
         tr.write_line(f"{c:<18}{drawn:>7}{share:>12}{ok:>14}{flag:>8}{secs:>9.1f}")
     for reason, n in sorted(REJECTED.items()):
         if reason.startswith(tag):

@@ -33,8 +33,9 @@ from tests.helpers import check_homeomorphism  # noqa: E402
 from tests.strategies import FEATURE_CLASSES, cad_models, moved  # noqa: E402
 
 DEEP = os.environ.get("HYPOTHESIS_PROFILE") == "deep"
-#: a survey (``make fuzz FUZZ_SURVEY=1``): no shrinking, and a failing model is
-#: counted and listed with its recipe instead of ending its class's run, so
+#: a survey (``make fuzz FUZZ_SURVEY=1``): no shrinking, and a failing model (or
+#: one the geodesic check cannot judge) is counted and listed with its recipe
+#: instead of ending its class's run, so
 #: that the report gives every class's shares (shrinking one failure took
 #: 744 s of stop 43's 30-minute survey)
 SURVEY = os.environ.get("FUZZ_SURVEY") == "1"
@@ -102,7 +103,13 @@ def test_conforming_samplings_of_generated_models_reconstruct_homeomorphic(featu
     model = data.draw(cad_models(feature), label="model")
     fuzzstats.count(f"generated model ({feature})")
     r = scan(model.shape, target_points=TARGET_POINTS)
-    why = conformance(model.shape, r.points, r.face_id, r.meta["spacing"])
+    try:
+        why = conformance(model.shape, r.points, r.face_id, r.meta["spacing"])
+    except ValueError as err:  # the geodesic check could not judge the samples
+        if not SURVEY:
+            raise
+        fuzzstats.reject(f"generated model ({feature}) CHECK FAILED: {model.recipe}: {err}")
+        return
     if why is not None:
         # not the theorem's input: counted with its reason, not a counterexample
         fuzzstats.reject(f"generated model ({feature}) not conforming: {why}")
