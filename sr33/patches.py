@@ -49,7 +49,7 @@ from scipy.spatial import QhullError
 
 from .cycles import CycleSet
 from .graph import cycle_edges
-from .mesh import delaunay_triangles, edge_keys
+from .mesh import delaunay_triangles, edge_keys, half_edges, unique_edges
 
 
 @dataclass(frozen=True)
@@ -58,8 +58,6 @@ class Patch:
 
     Attributes
     ----------
-    face : int
-        The face's index.
     interior : (s,) int64
         The strays inside it, ascending.
     triangles : (L - 2 + 2s, 3) int64
@@ -69,7 +67,6 @@ class Patch:
         have none (and no interior).
     """
 
-    face: int
     interior: np.ndarray
     triangles: np.ndarray
 
@@ -197,15 +194,10 @@ def chart_patch(points, cycle, interior) -> np.ndarray | None:
     simp = simp[_inside(poly, cen, 0.0)]
     if simp.shape[0] != L - 2 + 2 * s:
         return None
-    # every side of the polygon is an edge of exactly one kept triangle
-    m = L + s
-    tk = np.concatenate([simp[:, [0, 1]], simp[:, [1, 2]], simp[:, [2, 0]]])
-    keys, counts = np.unique(edge_keys(tk.min(axis=1), tk.max(axis=1), m), return_counts=True)
+    # the kept triangles' boundary is exactly the polygon's sides
+    keys, counts = unique_edges(half_edges(simp)[0], return_counts=True)
     sides = np.arange(L)
-    side_keys = edge_keys(np.minimum(sides, (sides + 1) % L), np.maximum(sides, (sides + 1) % L), m)
-    pos = np.searchsorted(keys, side_keys)
-    pos = np.minimum(pos, keys.shape[0] - 1)
-    if not (np.array_equal(keys[pos], side_keys) and np.all(counts[pos] == 1)):
+    if not np.array_equal(keys[counts == 1], unique_edges(np.c_[sides, (sides + 1) % L])):
         return None
     return np.concatenate([cyc, ins])[simp]  # counter-clockwise in the chart
 
@@ -370,7 +362,6 @@ def stray_patches(
         )
         for f in host:
             out[f] = Patch(
-                face=int(f),
                 interior=ins if f == first else np.empty(0, np.int64),
                 triangles=tri if f == first else np.empty((0, 3), np.int64),
             )

@@ -206,10 +206,9 @@ class _Figures:
 
 
 def _figures(faces: CycleSet, n: int) -> _Figures:
-    used = np.zeros(n, dtype=bool)
+    used = faces.used(n)
     if len(faces) == 0:
         return _Figures(np.empty((0, 2), np.int64), 0, np.zeros(n, dtype=bool), used)
-    used[faces.vertices] = True
     pairs, _ = cycle_edges(faces.offsets, faces.vertices)
     keys, cnt = np.unique(edge_keys(pairs[:, 0], pairs[:, 1], n), return_counts=True)
     once = keys[cnt == 1]

@@ -119,8 +119,7 @@ def test_the_ring_face_takes_the_cluster_that_reaches_only_its_samples():
     assert stray_patches(pts, faces, off, min_interior=2) == {}
     # fewer strays than min_interior: left to the ring centres
     one = np.array([[L, 0]])
-    faces_one = faces
-    assert stray_patches(pts, faces_one, one, min_interior=2) == {}
+    assert stray_patches(pts, faces, one, min_interior=2) == {}
 
 
 def test_triangulate_orients_a_patch_with_its_face_and_keeps_the_euler_characteristic():
