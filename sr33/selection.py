@@ -25,27 +25,29 @@ cycles fixed next to them), with the rest of the selection held fixed:
   "Conv(N(u; k)) ∩ P' is a disk"): a circuit constraint per sample, added
   lazily at the samples where a solution was pinched;
 * no detached closed bubble: every face reaches a face outside the region
-  through faces (rooted connectivity by levels, up front; a connectivity
-  cut per bubble found, lazily, where the component touches no outside
-  face and its largest piece is kept).
+  through faces.  First by lazy cuts only (a connectivity cut per bubble
+  found: a face of it needs a neighbouring face outside it); where those
+  rounds keep finding new bubbles until the budget ends, the closed model
+  is solved again with rooted connectivity by levels up front (slower per
+  model, but it settles).  Where the component touches no outside face,
+  its largest piece is kept.
 
-The objective is lexicographic: open edges, then the negative Euler
-characteristic of the region (each handle costs 2; V counts used samples,
-so covering a sample with the same topology changes nothing), then stray
-samples, then the total area of the faces (``Incidence.cycle_cost``: each
-cycle's fan area in units of a sixteenth of the median cycle's).  Of the
-closed selections with the same coverage, the least area is the one that
-follows the surface: at an acute sharp edge, where the Euclidean RNG joins
-samples across the edge at every scan height, a stack of such "plates"
-closes the surface too, but folded like an accordion about a sample
-spacing deep; a smaller-faces-first tie-break chose the plates (they are
-triangles).  Maximising the Euler characteristic keeps the solver from buying
-coverage with handles.  It is solved in two phases from the same model:
-stray samples first without the Euler term (fast, and proven optimal on
-the library shapes), then with it, warm-started from the first answer.
-An answer is taken only when it is valid (edge use at most two, links
-disks) and strictly better than the selection it replaces, so the result
-is never worse than the greedy fallback.
+The objective is lexicographic: open edges (the open model only), then
+stray samples, then the total area of the faces (``Incidence.cycle_cost``:
+each cycle's fan area in units of a sixteenth of the median cycle's).  Of
+the closed selections with the same coverage, the least area is the one
+that follows the surface: at an acute sharp edge, where the Euclidean RNG
+joins samples across the edge at every scan height, a stack of such
+"plates" closes the surface too, but folded like an accordion about a
+sample spacing deep; a smaller-faces-first tie-break chose the plates
+(they are triangles).  The Euler characteristic is not in the objective
+(it rewards detached bubbles, which the lazy cuts then chase round by
+round): an answer is taken only when it is valid (edge use at most two,
+links disks) and strictly better than the selection it replaces (the
+closed model: no open edge, then the region's Euler characteristic,
+highest first, then stray samples, then area; the open model: open edges
+and strays, then area), so the result is never worse than the greedy
+fallback and never buys coverage with a handle.
 """
 
 from __future__ import annotations
@@ -183,7 +185,8 @@ class _Score:
     area: int
 
     def better_than(self, old: _Score, closed: bool) -> bool:
-        """The order of the model's objective (closed or open)."""
+        """The order answers are taken in (closed: Euler characteristic
+        first, which the model itself does not weigh; open: the model's)."""
         if self.over:
             return False
         if old.over or (closed and old.open):
@@ -307,7 +310,7 @@ def _connect(m, tab, state, cycles, cyc_set, x) -> None:
 
 
 def _solve_component(
-    tab, state, cycles, conflicts, lone, seconds, max_rounds, links, allow_open, chi, outside
+    tab, state, cycles, conflicts, lone, seconds, max_rounds, links, allow_open, outside, levels
 ):
     """One CP-SAT model over ``cycles``, lazy rounds until valid.
 
@@ -315,8 +318,10 @@ def _solve_component(
     extended with the samples cut lazily.  ``outside``: a selected cycle
     outside ``cycles`` shares an edge with them (:func:`_touches_outside`,
     the same for every model of one component: only its cycles change).
+    ``levels``: forbid detached bubbles up front (:func:`_connect`) instead
+    of by lazy cuts only.
     Returns (new state or None, proven -- optimal, or with None infeasible --,
-    cuts, the budget spent in seconds).
+    cuts).
     """
     from ortools.sat.python import cp_model
 
@@ -374,12 +379,12 @@ def _solve_component(
             m.AddImplication(lit, cv)
         m.AddBoolOr(mine + [cv.Not()])
         cov[v] = cv
-    # objective, lexicographic by weights.  Closed model: -chi (when asked),
-    # then strays, then area.  Open model (no closed answer):
+    # objective, lexicographic by weights.  Closed model: strays, then
+    # area.  Open model (no closed answer):
     # open edges and strays together (a hole and a lost sample weigh the
     # same; removing faces to avoid an open edge loses their samples), then
     # open true-boundary edges, then area.
-    nv, ne = len(verts), len(edges_)
+    ne = len(edges_)
     cost = {c: int(tab.cost[c]) for c in cycles}
     strays = [1 - cov[v] if isinstance(cov[v], int) else cov[v].Not() for v in verts]
     area = sum(cost[c] * x[c] for c in cycles)
@@ -390,10 +395,7 @@ def _solve_component(
         w_main = w_stray * (ne + 1)
         obj = w_main * (sum(open_bad) + sum(strays)) + w_stray * sum(open_lone) + area
     else:
-        w_chi = w_stray * (nv + 1) if chi else 0
-        chi_terms = [cov[v] for v in verts]
-        used = [y[e] for e in edges_]
-        obj = -w_chi * (sum(chi_terms) - sum(used) + sum(x.values())) + w_stray * sum(strays) + area
+        obj = w_stray * sum(strays) + area
     m.Minimize(obj)
 
     def add_link(v: int) -> None:
@@ -453,8 +455,9 @@ def _solve_component(
     for v in sorted(links & set(verts)):
         add_link(v)
     # a component next to faces outside it must reach them; one that touches
-    # none (a separate object) keeps its largest piece
-    if outside:
+    # none (a separate object) keeps its largest piece.  Up front by levels,
+    # or by the lazy cuts below only
+    if outside and levels:
         _connect(m, tab, state, cycles, cyc_set, x)
     elif not allow_open:
         m.Add(sum(x.values()) >= 1)  # closing a lone component by deleting it
@@ -463,7 +466,6 @@ def _solve_component(
     solver.parameters.random_seed = 0
     solver.parameters.randomize_search = False
     budget = seconds * _DET_PER_SECOND
-    spent = 0.0
     cuts = 0
     best = None
     proven = False
@@ -473,7 +475,6 @@ def _solve_component(
         solver.parameters.max_deterministic_time = budget
         status = solver.Solve(m)
         budget -= solver.deterministic_time
-        spent += solver.deterministic_time
         if status not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
             # INFEASIBLE: proven that no selection meets the model (the lazy
             # cuts only ever add constraints)
@@ -503,11 +504,11 @@ def _solve_component(
                 m.AddBoolOr([x[d] for d in ring] + [x[c].Not()])
         cuts += len(bad) + len(bubbles)
         log.debug(
-            "exact selection: %d cycles, open %s, chi %s, status %s, objective %d, "
+            "exact selection: %d cycles, open %s, levels %s, status %s, objective %d, "
             "%d pinched samples, %d bubbles, %.2f deterministic s",
             len(cycles),
             allow_open,
-            chi,
+            levels,
             solver.StatusName(status),
             solver.ObjectiveValue(),
             len(bad),
@@ -522,7 +523,7 @@ def _solve_component(
         m.ClearHints()
         for c in cycles:
             m.AddHint(x[c], int(trial[c]))
-    return best, proven, cuts, spent / _DET_PER_SECOND
+    return best, proven, cuts
 
 
 def exact_selection(
@@ -587,40 +588,32 @@ def exact_selection(
         outside = _touches_outside(tab, state, comp)
         bubbled = bool(_bubbles(tab, state, comp, outside))
         for allow_open in (False, True):
-            # coverage first (fast, proven on the library shapes), then the
-            # Euler characteristic from that answer: no handle bought with
-            # coverage.  The second phase polishes: it gets the time the
-            # first took, at least a quarter of the budget (where the first
-            # was proven quickly, the second rarely changes the Euler
-            # characteristic: star_prism's five never did, and waited out
-            # the whole budget to prove it)
+            # lazy bubble cuts first (fast: most models are proven optimal in
+            # a few rounds); where the rounds keep finding new bubbles until
+            # the budget ends, the closed model is solved again with the
+            # bubbles forbidden up front by levels (slow, but it settles;
+            # levels bind only a component next to faces outside it)
+            modes = (False, True) if outside and not allow_open else (False,)
             best, prov = None, False
-            hint = state
-            budget = seconds
-            for chi in (False, True) if not allow_open else (False,):
-                new, p, cut, spent = _solve_component(
+            for levels in modes:
+                best, prov, cut = _solve_component(
                     tab,
-                    hint,
+                    state,
                     comp,
                     conflicts,
                     lone,
-                    budget,
+                    seconds,
                     max_rounds,
                     links,
                     allow_open,
-                    chi,
                     outside,
+                    levels,
                 )
                 cuts += cut
-                budget = min(seconds, max(spent, 0.25 * seconds))
-                if new is not None:
-                    best, prov, hint = new, p, new
-                elif p:
-                    # proven infeasible: the Euler phase has the same
-                    # constraints (cheburashka: two of five components, 0.2 s)
+                if best is not None or prov:
                     break
             if best is None:
-                continue
+                continue  # infeasible or out of time: the open model follows
             if bubbled or _score(tab, best, comp, edges_, verts_, lone).better_than(
                 before, not allow_open
             ):
