@@ -145,6 +145,26 @@ def goes_round(face) -> bool:
     return abs((umax - umin) - 2 * math.pi) <= 1e-9
 
 
+def whole_band(face) -> bool:
+    """Whether a face of revolution goes all the way round its axis between
+    whole circles only: every boundary edge but its seam and a degenerate
+    apex is a closed circle.  A cone or cylinder notched by a boolean cut
+    also spans the full turn of its parameter, but part of each row round it
+    is missing (the layouts that lay whole rings round such a band put
+    samples in the notch, off the face)."""
+    from OCP.BRep import BRep_Tool
+
+    if not goes_round(face):
+        return False
+    for edge in face.Edges():
+        w = edge.wrapped
+        if BRep_Tool.Degenerated_s(w) or BRep_Tool.IsClosed_s(w, face.wrapped):
+            continue  # the apex; the seam (both sides of the face)
+        if edge.geomType() != "CIRCLE" or not BRep_Tool.IsClosed_s(w):
+            return False
+    return True
+
+
 def revolution_axis(face):
     """(point, unit direction) of a cone's, cylinder's, sphere's or torus's
     axis (a sphere's and a torus's point is its centre)."""

@@ -50,6 +50,7 @@ from .faces import (
     revolution_axis,
     row_cosine,
     steps,
+    whole_band,
 )
 from .repair import GAP, MOVABLE, Repaired, copies, repair, split_corners
 from .rings import HALVING_GAP, ring_positions
@@ -706,9 +707,11 @@ def _follow_columns(s: Samples, shifts: dict[int, list], faces, tol: float) -> N
 
 def _full_turns(occ, kind: str):
     """(index, face) of the faces of a surface type that go all the way round
-    (a partial cylinder is a fillet: its smooth edges are not sampled)."""
+    between whole circles (a partial cylinder is a fillet: its smooth edges
+    are not sampled; a notched one is left to the scan rows and the repair,
+    :func:`sr33.samplers.faces.whole_band`)."""
     for fi, face in enumerate(occ.Faces()):
-        if face.geomType() == kind and goes_round(face):
+        if face.geomType() == kind and whole_band(face):
             yield fi, face
 
 

@@ -76,6 +76,20 @@ def test_unreachable_resolution_is_an_error(plane):
         sample_conditions(p, *plane)
 
 
+def test_samples_off_the_truth_are_named_not_a_vertex_clash(plane):
+    """Two samples beyond the truth's corner both land on its corner vertex;
+    the check says they are off the truth's surface (the stop 45 survey's
+    notched cone had 59 samples up to 4.3 h off it), not that two samples
+    fall on one vertex."""
+    p, _ = lattice(0.002)
+    far = np.array([[0.65, 0.62, 0.0], [0.62, 0.65, 0.0]])
+    with pytest.raises(
+        ValueError,
+        match=r"^2 samples lie more than 0.5 h off the truth \(sample 10[01]: 1\.9[0-9] h\)",
+    ):
+        sample_conditions(np.vstack([p, far]), *plane)
+
+
 def test_exact_square_lattice_dt_m_is_right_isosceles(plane):
     p, n = lattice(0.0)
     r = sample_conditions(p, *plane)

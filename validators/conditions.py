@@ -26,6 +26,7 @@ from sr33.mesh import SQRT3_2, as_mesh, triangle_ratios, unique_rows
 
 OFF_TRUTH = 0.1  # h: farther from the truth, a sample is measured where it snaps, not where it is
 OFF_FRAME = 1.0  # h: a median this far off is another frame or unit, not a sampling
+OFF_SAMPLE = 0.5  # h: a sample this far off the truth is off its surface
 
 
 @dataclass(frozen=True)
@@ -774,7 +775,18 @@ def sample_conditions(
     with timed("conditions: truth refined"):
         local = _LocalResolution(tree, nn[:, 1], resolution)
         tv, tf = refine_to_edge_length(ov, of, resolution, local=local)
-        tv, tf, snap = insert_points(tv, tf, pts)
+        try:
+            tv, tf, snap = insert_points(tv, tf, pts)
+        except ValueError as exc:
+            far = np.flatnonzero(off > OFF_SAMPLE)
+            if far.size == 0:
+                raise
+            worst = int(far[np.argmax(off[far])])
+            raise ValueError(
+                f"{far.size} samples lie more than {OFF_SAMPLE} h off the truth (sample "
+                f"{worst}: {off[worst]:.3g} h), and the check cannot place them on it: "
+                "the samples must lie on the truth's surface"
+            ) from exc
     with timed("conditions: labels"):
         dt_edges, crossings, dt_tri = _labelled_delaunay(tv, tf, snap, pts, sharp_degrees)
         orphans = np.setdiff1d(np.arange(n), dt_tri)
