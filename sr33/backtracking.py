@@ -761,8 +761,9 @@ def backtracking(
     budget : int
         Maximum assignments of the strict search per component.
     exact_seconds : float
-        Budget of the exact selection (:mod:`sr33.selection`) per region
-        component where the strict search failed; 0 keeps the greedy answer.
+        Budget of the exact selection (:mod:`sr33.selection`) per model of
+        a region component where the strict search failed; 0 keeps the
+        greedy answer.
     quiet : bool
         Hide the progress bar.
 

@@ -457,7 +457,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--exact-seconds",
         type=float,
         default=5.0,
-        help="exact selection budget per failed component and phase, in CP-SAT "
+        help="exact selection budget per model of a failed component (closed, then "
+        "with levels or open where needed), in CP-SAT "
         "deterministic time (about seconds of one core; the same on every machine; "
         "0 keeps the greedy answer)",
     )

@@ -550,8 +550,10 @@ def exact_selection(
     conflicts : dict
         Cycle -> cycles it may not be selected with (folds and crossings).
     seconds : float
-        Budget per component (CP-SAT deterministic time, shared by the
-        lazy rounds).
+        Budget per model of a component (CP-SAT deterministic time, shared
+        by its lazy rounds): the closed model, then, where it gives no
+        answer in time, the closed model with levels (next to outside
+        faces), then the open model where no closed answer came.
     max_rounds : int
         Lazy rounds per component.
 
