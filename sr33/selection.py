@@ -459,7 +459,7 @@ def _solve_component(
     # or by the lazy cuts below only
     if outside and levels:
         _connect(m, tab, state, cycles, cyc_set, x)
-    elif not allow_open:
+    elif not outside and not allow_open:
         m.Add(sum(x.values()) >= 1)  # closing a lone component by deleting it
     solver = cp_model.CpSolver()
     solver.parameters.num_workers = 1
