@@ -61,9 +61,10 @@ from scipy.sparse import csgraph
 from .graph import link_is_disk
 from .progress import log
 
-#: CP-SAT deterministic time per second of ``seconds``: on these models one
-#: deterministic unit took about four seconds of one core, so ``seconds`` is
-#: close to wall-clock seconds (the limit itself is machine-independent)
+#: CP-SAT deterministic time per second of ``seconds``: on the models first
+#: measured one deterministic unit took about four seconds of one core, on
+#: cheburashka's (stop 45) two to three, so ``seconds`` is at most about
+#: wall-clock seconds (the limit itself is machine-independent)
 _DET_PER_SECOND = 0.25
 
 
