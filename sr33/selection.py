@@ -597,7 +597,6 @@ def exact_selection(
             # bubbles forbidden up front by levels (slow, but it settles;
             # levels bind only a component next to faces outside it)
             modes = (False, True) if outside and not allow_open else (False,)
-            best, prov = None, False
             for levels in modes:
                 best, prov, cut = _solve_component(
                     tab,

@@ -69,6 +69,28 @@ def test_the_exact_selection_is_deterministic():
     assert len(runs) == 1
 
 
+def _record_solves(monkeypatch, withhold=None):
+    """Record every CP-SAT model the exact selection solves: (its bound
+    arguments, its answer).  A model ``withhold`` picks gets no answer
+    (as if out of time) without being solved."""
+    import inspect
+
+    from sr33 import selection
+
+    solves = []
+    solve = selection._solve_component
+    signature = inspect.signature(solve)
+
+    def recorded(*args, **kwargs):
+        given = signature.bind(*args, **kwargs).arguments
+        out = (None, False, 0) if withhold and withhold(given) else solve(*args, **kwargs)
+        solves.append((given, out))
+        return out
+
+    monkeypatch.setattr(selection, "_solve_component", recorded)
+    return solves
+
+
 def test_a_closed_model_proven_infeasible_skips_the_levels_model(monkeypatch):
     """Three triangles on one edge (a book of three pages): a closed selection
     needs every edge twice, and each page's two other edges lie in it alone, so
@@ -76,21 +98,7 @@ def test_a_closed_model_proven_infeasible_skips_the_levels_model(monkeypatch):
     The model with levels up front has the same constraints and more, and is
     not run; the open model follows and the fallback's two pages stand
     (cheburashka: two of five components, 0.2 s)."""
-    import inspect
-
-    from sr33 import selection
-
-    calls = []
-    solve = selection._solve_component
-    signature = inspect.signature(solve)
-
-    def recorded(*args, **kwargs):
-        out = solve(*args, **kwargs)
-        given = signature.bind(*args, **kwargs).arguments
-        calls.append((given["allow_open"], given["levels"], out[0] is not None, out[1]))
-        return out
-
-    monkeypatch.setattr(selection, "_solve_component", recorded)
+    solves = _record_solves(monkeypatch)
     pts = np.array(
         [[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, -0.5, 0.8], [0.5, -0.5, -0.8]], dtype=float
     )
@@ -98,6 +106,7 @@ def test_a_closed_model_proven_infeasible_skips_the_levels_model(monkeypatch):
     cyc = trivial_isometric_cycles(e, len(pts))
     assert len(cyc) == 3
     sel = backtracking(pts, e, cyc)
+    calls = [(g["allow_open"], g["levels"], out[0] is not None, out[1]) for g, out in solves]
     # closed: no answer, proven; open: an answer, proven optimal
     assert calls == [(False, False, False, True), (True, False, True, True)]
     assert sel.success and len(sel.faces) == 2 and sel.exact.components == 1
@@ -110,36 +119,21 @@ def test_lazy_bubble_rounds_out_of_time_fall_back_to_levels(monkeypatch):
     lazy answer is withheld here to force that path, on the conebox the deep
     profile found open at its junction (one failed component of 12 cycles,
     next to faces outside it)."""
-    import inspect
-
     import pytest
 
     pytest.importorskip("cadquery")
-    from sr33 import reconstruct, selection
+    from sr33 import reconstruct
     from sr33.samplers import shapes
     from sr33.samplers.scanline import scan
     from sr33.validators import mesh_stats
-
-    calls = []
-    solve = selection._solve_component
-    signature = inspect.signature(solve)
-
-    def lazy_out_of_time(*args, **kwargs):
-        given = signature.bind(*args, **kwargs).arguments
-        key = (given["allow_open"], given["outside"], given["levels"])
-        if not given["allow_open"] and not given["levels"]:
-            calls.append((*key, False))
-            return None, False, 0
-        out = solve(*args, **kwargs)
-        calls.append((*key, out[0] is not None))
-        return out
 
     s = shapes.build(
         "conebox", length=1.0, width=1.0, height=0.5625, cone_radius=0.39375, cone_height=0.6
     )
     pts = scan(s, s.default_spacing / 1.125, ratio=0.8671875, repair=False).points
-    monkeypatch.setattr(selection, "_solve_component", lazy_out_of_time)
+    solves = _record_solves(monkeypatch, withhold=lambda g: not g["allow_open"] and not g["levels"])
     r = reconstruct(pts, 33)
+    calls = [(g["allow_open"], g["outside"], g["levels"], out[0] is not None) for g, out in solves]
     # the lazy closed model, then the levels one, which answers
     assert calls == [(False, True, False, False), (False, True, True, True)]
     st = mesh_stats(r.triangles, r.vertices.shape[0])
