@@ -90,7 +90,8 @@ def _cmd_reconstruct(args) -> int:
         rows += [
             (
                 "exact selection",
-                f"{e.improved} of {e.components} improved, {e.proven} proven optimal",
+                f"{e.improved} of {e.components} improved, {e.proven} proven optimal"
+                + (f", {e.grown} after freeing the faces round them" if e.grown else ""),
             )
         ]
     rows += [(f"seconds {s}", f"{r.timings.get(s, 0.0):.3f}") for s in STEPS]
@@ -107,7 +108,7 @@ def _cmd_reconstruct(args) -> int:
             "coned_samples": int(r.coned_samples.shape[0]),
             "fallback_components": r.fallback_components,
             "exact_selection": dict(
-                zip(("components", "improved", "proven", "cuts"), r.exact.as_tuple())
+                zip(("components", "improved", "proven", "cuts", "grown"), r.exact.as_tuple())
             ),
             "stats": stats.as_dict(),
             "seconds": r.timings,

@@ -557,7 +557,8 @@ def load_reconstruction(path):
                 fallback_components=int(s[4]),
                 # files of earlier versions end after k
                 hole_faces=int(s[6]) if s.shape[0] > 6 else 0,
-                exact=ExactReport(*(int(x) for x in s[7:11])) if s.shape[0] > 10 else ExactReport(),
+                # files of earlier versions have 4 exact-selection figures, or none
+                exact=ExactReport(*(int(x) for x in s[7:12])),
                 timings=dict(zip(z["timing_names"].tolist(), z["timing_values"].tolist())),
                 k=int(s[5]),
             )

@@ -30,7 +30,13 @@ cycles fixed next to them), with the rest of the selection held fixed:
   rounds keep finding new bubbles until the budget ends, the closed model
   is solved again with rooted connectivity by levels up front (slower per
   model, but it settles).  Where the component touches no outside face,
-  its largest piece is kept.
+  its largest piece is kept;
+* where the closed model is proven infeasible with the selection round
+  the component held fixed, the cycles sharing a sample with the model
+  are freed and it is solved again (up to ``rings`` times): on input that
+  does not conform, a face decided on its own (no candidate competes for
+  its edges) can be what makes closing impossible.  Only then the open
+  model, over the component itself.
 
 The objective is lexicographic: open edges (the open model only), then
 stray samples, then the total area of the faces (``Incidence.cycle_cost``:
@@ -67,6 +73,14 @@ from .progress import log
 #: wall-clock seconds (the limit itself is machine-independent)
 _DET_PER_SECOND = 0.25
 
+#: CP-SAT's parameters: one worker, a fixed seed, no randomisation (the same
+#: model always gives the same answer)
+_PARAMETERS = {
+    "num_workers": 1,
+    "random_seed": 0,
+    "randomize_search": False,
+}
+
 
 @dataclass(frozen=True)
 class ExactReport:
@@ -82,16 +96,20 @@ class ExactReport:
         Components whose answer is proven optimal for the model.
     cuts : int
         Lazy constraints added (vertex links and bubbles).
+    grown : int
+        Components closed only once the faces round them were freed (their
+        closed model was infeasible with those faces held fixed).
     """
 
     components: int = 0
     improved: int = 0
     proven: int = 0
     cuts: int = 0
+    grown: int = 0
 
-    def as_tuple(self) -> tuple[int, int, int, int]:
-        """(components, improved, proven, cuts)."""
-        return (self.components, self.improved, self.proven, self.cuts)
+    def as_tuple(self) -> tuple[int, int, int, int, int]:
+        """(components, improved, proven, cuts, grown)."""
+        return (self.components, self.improved, self.proven, self.cuts, self.grown)
 
 
 @dataclass
@@ -327,8 +345,7 @@ def _solve_component(
     from ortools.sat.python import cp_model
 
     cyc_set = set(cycles)
-    edges_ = sorted({int(e) for c in cycles for e in tab.cycle_edges[c]})
-    verts = sorted({int(v) for c in cycles for v in tab.cycle_vertices[c]})
+    edges_, verts = _extent(tab, cycles)
     m = cp_model.CpModel()
     x = {c: m.NewBoolVar(f"x{c}") for c in cycles}
     hint = {c: int(state[c] == 1) for c in cycles}
@@ -463,9 +480,8 @@ def _solve_component(
     elif not outside and not allow_open:
         m.Add(sum(x.values()) >= 1)  # closing a lone component by deleting it
     solver = cp_model.CpSolver()
-    solver.parameters.num_workers = 1
-    solver.parameters.random_seed = 0
-    solver.parameters.randomize_search = False
+    for key, value in _PARAMETERS.items():
+        setattr(solver.parameters, key, value)
     budget = seconds * _DET_PER_SECOND
     cuts = 0
     best = None
@@ -527,6 +543,58 @@ def _solve_component(
     return best, proven, cuts
 
 
+def _extent(tab: _Tables, cycles) -> tuple[list[int], list[int]]:
+    """The edges and the samples of ``cycles``, sorted."""
+    edges_ = sorted({int(e) for c in cycles for e in tab.cycle_edges[c]})
+    verts = sorted({int(v) for c in cycles for v in tab.cycle_vertices[c]})
+    return edges_, verts
+
+
+def _ring(tab: _Tables, cycles) -> list[int]:
+    """``cycles`` and every cycle with a sample of theirs, sorted."""
+    _, verts = _extent(tab, cycles)
+    out = set(cycles)
+    for v in verts:
+        out.update(int(c) for c in tab.corner_owner[tab.corners_at(v)])
+    return sorted(out)
+
+
+def _closed(tab, state, cycles, conflicts, lone, seconds, max_rounds, links):
+    """The closed models of ``cycles``: lazy bubble cuts, then (next to faces
+    outside, where those rounds run out of time) levels.
+
+    Takes the answer into ``state`` when it is better than the selection
+    there.  Returns (an answer was found, proven -- optimal, or without an
+    answer infeasible --, cuts, the answer was taken).
+    """
+    edges_, verts_ = _extent(tab, cycles)
+    before = _score(tab, state, cycles, edges_, verts_, lone)
+    # a selection given with a detached bubble is beaten by any valid answer
+    # (they have none): its extra spheres raise the Euler characteristic the
+    # comparison would otherwise prefer
+    outside = _touches_outside(tab, state, cycles)
+    bubbled = bool(_bubbles(tab, state, cycles, outside))
+    cuts = 0
+    best, prov = None, False
+    # lazy bubble cuts first (fast: most models are proven optimal in a few
+    # rounds); where the rounds keep finding new bubbles until the budget
+    # ends, the model is solved again with the bubbles forbidden up front by
+    # levels (slow, but it settles; levels bind only next to faces outside)
+    for levels in (False, True) if outside else (False,):
+        best, prov, cut = _solve_component(
+            tab, state, cycles, conflicts, lone, seconds, max_rounds, links, False, outside, levels
+        )
+        cuts += cut
+        if best is not None or prov:
+            break
+    if best is None:
+        return False, prov, cuts, False
+    took = bubbled or _score(tab, best, cycles, edges_, verts_, lone).better_than(before, True)
+    if took:
+        state[:] = best
+    return True, prov, cuts, took
+
+
 def exact_selection(
     incidence: Incidence,
     state: np.ndarray,
@@ -535,6 +603,7 @@ def exact_selection(
     *,
     seconds: float = 5.0,
     max_rounds: int = 40,
+    rings: int = 2,
 ) -> ExactReport:
     """Select the faces of ``region`` exactly; updates ``state`` in place.
 
@@ -557,6 +626,11 @@ def exact_selection(
         faces), then the open model where no closed answer came.
     max_rounds : int
         Lazy rounds per component.
+    rings : int
+        Where the closed model is proven infeasible with the selection
+        round the component held fixed, the cycles sharing a sample with
+        the model are freed and it is solved again, up to ``rings`` times
+        (before the open model).
 
     Returns
     -------
@@ -579,48 +653,48 @@ def exact_selection(
     _, labels = csgraph.connected_components(g, directed=False)
     lab = labels[: region.shape[0]]
     comps = [region[lab == j].tolist() for j in np.unique(lab)]
-    improved = proven = cuts = 0
+    improved = proven = cuts = grown = 0
     for comp in comps:
-        edges_ = sorted({int(e) for c in comp for e in tab.cycle_edges[c]})
-        verts_ = sorted({int(v) for c in comp for v in tab.cycle_vertices[c]})
         links: set[int] = set()  # lazily (all up front: 2x slower, no better)
-        before = _score(tab, state, comp, edges_, verts_, lone)
-        # a selection given with a detached bubble is beaten by any valid
-        # answer (they have none): its extra spheres raise the Euler
-        # characteristic the comparison would otherwise prefer
+        answered = False
+        cur = comp
+        for ring in range(rings + 1):
+            found, prov, cut, took = _closed(
+                tab, state, cur, conflicts, lone, seconds, max_rounds, links
+            )
+            cuts += cut
+            if found:
+                answered = True
+                improved += int(took)
+                proven += int(took and prov)
+                grown += int(took and ring > 0)
+                break
+            if not prov or ring == rings:
+                break  # out of time (a larger model would only take longer)
+            # proven infeasible with the faces round it held fixed: on input
+            # that does not conform a face decided on its own (no candidate
+            # competes for its edges) can be what makes closing impossible;
+            # free every cycle with a sample of the model and solve again
+            grow = _ring(tab, cur)
+            if len(grow) == len(cur):
+                break  # nothing round it to free
+            cur = grow
+        if answered:
+            continue
+        # no closed answer: the open model over the component itself
         outside = _touches_outside(tab, state, comp)
-        bubbled = bool(_bubbles(tab, state, comp, outside))
-        for allow_open in (False, True):
-            # lazy bubble cuts first (fast: most models are proven optimal in
-            # a few rounds); where the rounds keep finding new bubbles until
-            # the budget ends, the closed model is solved again with the
-            # bubbles forbidden up front by levels (slow, but it settles;
-            # levels bind only a component next to faces outside it)
-            modes = (False, True) if outside and not allow_open else (False,)
-            for levels in modes:
-                best, prov, cut = _solve_component(
-                    tab,
-                    state,
-                    comp,
-                    conflicts,
-                    lone,
-                    seconds,
-                    max_rounds,
-                    links,
-                    allow_open,
-                    outside,
-                    levels,
-                )
-                cuts += cut
-                if best is not None or prov:
-                    break
-            if best is None:
-                continue  # infeasible or out of time: the open model follows
-            if bubbled or _score(tab, best, comp, edges_, verts_, lone).better_than(
-                before, not allow_open
-            ):
-                state[:] = best
-                improved += 1
-                proven += int(prov)
-            break
-    return ExactReport(len(comps), improved, proven, cuts)
+        best, prov, cut = _solve_component(
+            tab, state, comp, conflicts, lone, seconds, max_rounds, links, True, outside, False
+        )
+        cuts += cut
+        if best is None:
+            continue
+        edges_, verts_ = _extent(tab, comp)
+        before = _score(tab, state, comp, edges_, verts_, lone)
+        if _bubbles(tab, state, comp, outside) or _score(
+            tab, best, comp, edges_, verts_, lone
+        ).better_than(before, False):
+            state[:] = best
+            improved += 1
+            proven += int(prov)
+    return ExactReport(len(comps), improved, proven, cuts, grown)

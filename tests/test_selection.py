@@ -138,3 +138,53 @@ def test_lazy_bubble_rounds_out_of_time_fall_back_to_levels(monkeypatch):
     assert calls == [(False, True, False, False), (False, True, True, True)]
     st = mesh_stats(r.triangles, r.vertices.shape[0])
     assert (st.open_edges, st.euler, st.components, st.used_vertices) == (0, 2, 1, len(pts))
+
+
+def _tetrahedron_incidence():
+    """The four faces of a tetrahedron as candidate cycles, read as
+    :func:`sr33.selection.exact_selection` reads them."""
+    from sr33.selection import Incidence
+
+    faces = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
+    edges = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)], dtype=np.int64)
+    edge_id = {tuple(r): i for i, r in enumerate(edges.tolist())}
+    owner, vertex, prev, nxt = [], [], [], []
+    for c, f in enumerate(faces):
+        for i, v in enumerate(f):
+            owner.append(c)
+            vertex.append(v)
+            prev.append(f[i - 1])
+            nxt.append(f[(i + 1) % 3])
+    ids = [
+        np.array([edge_id[tuple(sorted((f[i], f[(i + 1) % 3])))] for i in range(3)]) for f in faces
+    ]
+    return Incidence(
+        ids,
+        [np.array(f, dtype=np.int64) for f in faces],
+        *(np.array(a, dtype=np.int64) for a in (owner, vertex, prev, nxt)),
+        edges,
+        4,
+        np.full(4, 16, dtype=np.int64),
+    )
+
+
+def test_a_closed_model_infeasible_with_the_faces_round_it_fixed_is_grown():
+    """A tetrahedron's face f0 is the failed component; next to it f1 and f2
+    are held selected and f3 unselected.  Closing is impossible with those
+    fixed (f0's edge with f1 needs f0, its edge with f3 forbids it): proven
+    infeasible.  Freeing the faces that share a sample with the model (here
+    all four) closes the tetrahedron (cheburashka: two of five components,
+    whose open models had found no valid answer in 4 s each).  Without the
+    growth the open model keeps one open edge."""
+    from sr33.selection import exact_selection
+
+    inc = _tetrahedron_incidence()
+    given = np.array([0, 1, 1, 0], dtype=np.int64)
+    state = given.copy()
+    report = exact_selection(inc, state, np.array([0]), {})
+    assert state.tolist() == [1, 1, 1, 1]
+    assert report.as_tuple()[:3] == (1, 1, 1) and report.grown == 1
+    state = given.copy()
+    report = exact_selection(inc, state, np.array([0]), {}, rings=0)
+    assert state.tolist() == [1, 1, 1, 0]  # the open model: the edge (1, 2) open
+    assert report.improved == 1 and report.grown == 0
