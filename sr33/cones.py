@@ -297,12 +297,19 @@ def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
     near[seeds] = True
     for _ in range(2):  # two rings round the seeds
         near[tri[np.any(near[tri], axis=1)].ravel()] = True
+    # the triangles a flip can read: those with a sample next to a near one
+    # (a flip joins two neighbours of a near sample, so every neighbour of a
+    # near sample stays in this zone; the crossing test reads all triangles)
+    zone = near.copy()
+    zone[tri[np.any(near[tri], axis=1)].ravel()] = True
+    zone_tri = np.flatnonzero(np.any(zone[tri], axis=1))
     owner: dict[tuple[int, int], int] = {}
-    for i, (a, b, c) in enumerate(tri.tolist()):
+    for i, (a, b, c) in zip(zone_tri.tolist(), tri[zone_tri].tolist()):
         owner[a, b] = owner[b, c] = owner[c, a] = i
     # only edges of two coherently oriented triangles flip: an overloaded or
     # inconsistently oriented edge (a failed selection) keeps its triangles
-    keys, counts = unique_rows(np.sort(half_edges(tri)[0], axis=1), return_counts=True)
+    # (every triangle with an edge of the zone is in the zone)
+    keys, counts = unique_rows(np.sort(half_edges(tri[zone_tri])[0], axis=1), return_counts=True)
     manifold = {tuple(k) for k in keys[counts == 2].tolist()}
     near[np.unique(keys[counts != 2])] = False
     limit = np.radians(165.0)

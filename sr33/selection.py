@@ -38,6 +38,14 @@ cycles fixed next to them), with the rest of the selection held fixed:
   its edges) can be what makes closing impossible.  Only then the open
   model, over the component itself.
 
+Components are solved side by side first (one thread each, up to numba's
+thread count): their models read disjoint parts of the selection, CP-SAT
+releases the GIL while it solves, and every model runs on one worker, so
+the answers do not depend on the number of threads.  They are then taken
+in component order; an answer whose model read a cycle an earlier answer
+changed (a grown model reaching another component) or that crosses an
+earlier answer is solved again next to it.
+
 The objective is lexicographic: open edges (the open model only), then
 stray samples, then the total area of the faces (``Incidence.cycle_cost``:
 each cycle's fan area in units of a sixteenth of the median cycle's).  Of
@@ -569,9 +577,10 @@ def _closed(tab, state, cycles, conflicts, lone, seconds, max_rounds, links):
     """The closed models of ``cycles``: lazy bubble cuts, then (next to faces
     outside, where those rounds run out of time) levels.
 
-    Takes the answer into ``state`` when it is better than the selection
-    there.  Returns (an answer was found, proven -- optimal, or without an
-    answer infeasible --, cuts, the answer was taken).
+    Leaves ``state`` as it is (components are solved side by side).
+    Returns (an answer was found, proven -- optimal, or without an answer
+    infeasible --, cuts, the answer is better than the selection in
+    ``state`` and to be taken, the answer or None).
     """
     edges_, verts_ = _extent(tab, cycles)
     before = _score(tab, state, cycles, edges_, verts_, lone)
@@ -594,11 +603,56 @@ def _closed(tab, state, cycles, conflicts, lone, seconds, max_rounds, links):
         if best is not None or prov:
             break
     if best is None:
-        return False, prov, cuts, False
+        return False, prov, cuts, False, None
     took = bubbled or _score(tab, best, cycles, edges_, verts_, lone).better_than(before, True)
-    if took:
-        state[:] = best
-    return True, prov, cuts, took
+    return True, prov, cuts, took, best
+
+
+def _crosses(conflicts, state: np.ndarray, answer: np.ndarray, cycles) -> bool:
+    """Whether a face of ``answer`` among ``cycles`` conflicts with (crosses or
+    folds onto) a face selected in ``state`` outside them."""
+    inside = set(cycles)
+    return any(
+        answer[c] == 1 and d not in inside and state[d] == 1
+        for c in cycles
+        for d in conflicts.get(c, ())
+    )
+
+
+def _threads() -> int:
+    """Threads for the components' first models: numba's thread count
+    (``NUMBA_NUM_THREADS``, the machine's cores by default)."""
+    import numba
+
+    return max(1, int(numba.get_num_threads()))
+
+
+def _settle(tab, state, comp, conflicts, lone, seconds, max_rounds, links, rings):
+    """The closed models of a component, grown while proven infeasible.
+
+    Where the closed model is proven infeasible with the selection round
+    the component held fixed, the cycles sharing a sample with the model
+    are freed and it is solved again, up to ``rings`` times: on input that
+    does not conform a face decided on its own (no candidate competes for
+    its edges) can be what makes closing impossible.  Leaves ``state`` as
+    it is.  Returns :func:`_closed`'s five figures (cuts summed over the
+    models), the cycles of the last model, and how many rings it has.
+    """
+    cuts = 0
+    cur = comp
+    for ring in range(rings + 1):
+        found, prov, cut, took, best = _closed(
+            tab, state, cur, conflicts, lone, seconds, max_rounds, links
+        )
+        cuts += cut
+        if found or not prov or ring == rings:
+            # an answer, or out of time (a larger model would only take longer)
+            break
+        grow = _ring(tab, cur)
+        if len(grow) == len(cur):
+            break  # nothing round it to free
+        cur = grow
+    return found, prov, cuts, took, best, cur, ring
 
 
 def exact_selection(
@@ -660,32 +714,48 @@ def exact_selection(
     lab = labels[: region.shape[0]]
     comps = [region[lab == j].tolist() for j in np.unique(lab)]
     improved = proven = cuts = grown = 0
-    for comp in comps:
-        links: set[int] = set()  # lazily (all up front: 2x slower, no better)
-        answered = False
-        cur = comp
-        for ring in range(rings + 1):
-            found, prov, cut, took = _closed(
-                tab, state, cur, conflicts, lone, seconds, max_rounds, links
-            )
+
+    def settle(comp, links):
+        return _settle(tab, state, comp, conflicts, lone, seconds, max_rounds, links, rings)
+
+    # every component's closed models first, side by side: a model reads
+    # the selection only on the cycles sharing a sample with it (and, for
+    # crossings, the faces it may not cross), which differ between
+    # components unless a grown model reaches another one (checked below).
+    # CP-SAT releases the GIL while it solves and each model is solved
+    # alone on one worker, so the answers do not depend on the thread count
+    given = state.copy()
+    links_of = [set() for _ in comps]  # lazily (all up front: 2x slower, no better)
+    jobs = min(len(comps), _threads())
+    if jobs > 1:
+        from concurrent.futures import ThreadPoolExecutor
+
+        # the largest components first (the last to finish bounds the time)
+        order = sorted(range(len(comps)), key=lambda i: (-len(comps[i]), i))
+        with ThreadPoolExecutor(jobs) as pool:
+            done = dict(zip(order, pool.map(lambda i: settle(comps[i], links_of[i]), order)))
+        firsts = [done[i] for i in range(len(comps))]
+    else:
+        firsts = [settle(comp, links) for comp, links in zip(comps, links_of)]
+    # then in order: the answers taken, the open models where no closed
+    # answer came
+    for comp, links, first in zip(comps, links_of, firsts):
+        found, prov, cut, took, best, cur, ring = first
+        cuts += cut
+        read = _ring(tab, cur)
+        if np.any(state[read] != given[read]) or (took and _crosses(conflicts, state, best, cur)):
+            # an earlier answer changed what this model read, or this answer
+            # crosses an earlier one (it was solved next to the selection
+            # given): solved again next to them
+            log.debug("exact selection: a component solved again after an earlier answer")
+            found, prov, cut, took, best, cur, ring = settle(comp, links)
             cuts += cut
-            if found:
-                answered = True
-                improved += int(took)
-                proven += int(took and prov)
-                grown += int(took and ring > 0)
-                break
-            if not prov or ring == rings:
-                break  # out of time (a larger model would only take longer)
-            # proven infeasible with the faces round it held fixed: on input
-            # that does not conform a face decided on its own (no candidate
-            # competes for its edges) can be what makes closing impossible;
-            # free every cycle with a sample of the model and solve again
-            grow = _ring(tab, cur)
-            if len(grow) == len(cur):
-                break  # nothing round it to free
-            cur = grow
-        if answered:
+        if found:
+            if took:
+                state[cur] = best[cur]
+                improved += 1
+                proven += int(prov)
+                grown += int(ring > 0)
             continue
         # no closed answer: the open model over the component itself
         outside = _touches_outside(tab, state, comp)
@@ -700,7 +770,7 @@ def exact_selection(
         if _bubbles(tab, state, comp, outside) or _score(
             tab, best, comp, edges_, verts_, lone
         ).better_than(before, False):
-            state[:] = best
+            state[comp] = best[comp]
             improved += 1
             proven += int(prov)
     return ExactReport(len(comps), improved, proven, cuts, grown)

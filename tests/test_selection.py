@@ -140,13 +140,18 @@ def test_lazy_bubble_rounds_out_of_time_fall_back_to_levels(monkeypatch):
     assert (st.open_edges, st.euler, st.components, st.used_vertices) == (0, 2, 1, len(pts))
 
 
-def _tetrahedron_incidence():
-    """The four faces of a tetrahedron as candidate cycles, read as
+def _tetrahedra_incidence(count=1):
+    """The four faces of ``count`` tetrahedra (samples 4i..4i+3, faces
+    4i..4i+3) as candidate cycles, read as
     :func:`sr33.selection.exact_selection` reads them."""
     from sr33.selection import Incidence
 
-    faces = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
-    edges = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)], dtype=np.int64)
+    one = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
+    faces = [tuple(v + 4 * t for v in f) for t in range(count) for f in one]
+    edges = np.array(
+        [(a + 4 * t, b + 4 * t) for t in range(count) for a in range(4) for b in range(a + 1, 4)],
+        dtype=np.int64,
+    )
     edge_id = {tuple(r): i for i, r in enumerate(edges.tolist())}
     owner, vertex, prev, nxt = [], [], [], []
     for c, f in enumerate(faces):
@@ -163,8 +168,8 @@ def _tetrahedron_incidence():
         [np.array(f, dtype=np.int64) for f in faces],
         *(np.array(a, dtype=np.int64) for a in (owner, vertex, prev, nxt)),
         edges,
-        4,
-        np.full(4, 16, dtype=np.int64),
+        4 * count,
+        np.full(4 * count, 16, dtype=np.int64),
     )
 
 
@@ -178,7 +183,7 @@ def test_a_closed_model_infeasible_with_the_faces_round_it_fixed_is_grown():
     growth the open model keeps one open edge."""
     from sr33.selection import exact_selection
 
-    inc = _tetrahedron_incidence()
+    inc = _tetrahedra_incidence()
     given = np.array([0, 1, 1, 0], dtype=np.int64)
     state = given.copy()
     report = exact_selection(inc, state, np.array([0]), {})
@@ -188,3 +193,26 @@ def test_a_closed_model_infeasible_with_the_faces_round_it_fixed_is_grown():
     report = exact_selection(inc, state, np.array([0]), {}, rings=0)
     assert state.tolist() == [1, 1, 1, 0]  # the open model: the edge (1, 2) open
     assert report.improved == 1 and report.grown == 0
+
+
+def test_components_solved_side_by_side_match_one_at_a_time(monkeypatch):
+    """Two tetrahedra, each its own component, whose faces 0 and 4 cross
+    (a conflict).  Both first models are solved next to the selection given
+    (nothing), so both answers close their tetrahedron; the second answer
+    crosses the first one taken and is solved again next to it: face 4 is
+    forbidden, and the open model keeps three faces.  One thread or two:
+    the same selection and report."""
+    from sr33 import selection
+
+    inc = _tetrahedra_incidence(2)
+    conflicts = {0: [4], 4: [0]}
+    out = []
+    for threads in (1, 2):
+        monkeypatch.setattr(selection, "_threads", lambda threads=threads: threads)
+        state = np.zeros(8, dtype=np.int64)
+        report = selection.exact_selection(inc, state, np.arange(8), conflicts)
+        out.append((state.tolist(), report))
+    assert out[0] == out[1]
+    state, report = out[0]
+    assert state == [1, 1, 1, 1, 0, 1, 1, 1]
+    assert (report.components, report.improved) == (2, 2)
