@@ -137,9 +137,15 @@ class _Tables:
     corner_owner: np.ndarray
     corner_prev: np.ndarray
     corner_next: np.ndarray
-    edge_of: dict  # (a, b) sorted -> edge id
+    edge_keys: np.ndarray  # a * n + b of every edge (a < b), ascending
+    edge_order: np.ndarray  # edge ids in that order
     n_points: int
     cost: np.ndarray  # per cycle: its quantized area, the objective's last term
+
+    def edge_id(self, a: int, b: int) -> int:
+        """The id of the edge (a, b) (it must be an edge)."""
+        key = min(a, b) * self.n_points + max(a, b)
+        return int(self.edge_order[np.searchsorted(self.edge_keys, key)])
 
     def cycles_at_edge(self, e: int) -> np.ndarray:
         ec = self.edge_cycles
@@ -193,7 +199,8 @@ def _tables(inc: Incidence) -> _Tables:
         (np.arange(1, s + 1), (inc.corner_vertex, np.arange(s))), shape=(inc.n_points, s)
     )
     vc.sort_indices()
-    edge_of = {(int(a), int(b)): i for i, (a, b) in enumerate(edges.tolist())}
+    keys = edges[:, 0] * inc.n_points + edges[:, 1]
+    order = np.argsort(keys, kind="stable")
     return _Tables(
         list(ids),
         list(inc.cycle_vertices),
@@ -202,7 +209,8 @@ def _tables(inc: Incidence) -> _Tables:
         inc.corner_owner,
         inc.corner_prev,
         inc.corner_next,
-        edge_of,
+        keys[order],
+        order,
         inc.n_points,
         np.asarray(inc.cycle_cost, dtype=np.int64),
     )
@@ -453,7 +461,7 @@ def _solve_component(
         dummy = len(node)
         any_open = []
         for w, i in node.items():
-            e = tab.edge_of[(min(v, w), max(v, w))]
+            e = tab.edge_id(v, w)
             if e in y:
                 used_lit = y[e]
                 if e in o:
