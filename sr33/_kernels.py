@@ -22,7 +22,7 @@ def _sqdist(p, a, b):
     return dx * dx + dy * dy + dz * dz
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def local_rng_pairs(points, nb_indptr, nb_indices, shrink2, u_start, u_stop):
     """Union over all neighbourhoods of the neighbourhood's RNG edges.
 
@@ -124,8 +124,8 @@ def _is_isometric(indptr, indices, cyc, L, dist, queue):
     return True
 
 
-@njit(cache=True)
-def isometric_cycles(indptr, indices, max_len):
+@njit(cache=True, nogil=True)
+def isometric_cycles(indptr, indices, max_len, s_start, s_stop):
     """All isometric cycles of length 3..max_len of an undirected graph.
 
     The graph is CSR with sorted, symmetric adjacency.  A cycle is reported
@@ -134,7 +134,9 @@ def isometric_cycles(indptr, indices, max_len):
     characterisation of an isometric cycle seen from one of its vertices: the
     hop distance from ``s`` rises by one per step, may stay level once (odd
     length), then falls by one per step back to ``s``; every candidate is
-    then checked pairwise.  Returns ``(offsets, vertices)``.
+    then checked pairwise.  Only starts ``s_start <= s < s_stop`` are
+    searched (the caller splits the work over threads; the pieces, put
+    together in order, are the whole list).  Returns ``(offsets, vertices)``.
     """
     n = indptr.shape[0] - 1
     half = max_len // 2
@@ -150,7 +152,7 @@ def isometric_cycles(indptr, indices, max_len):
     verts = np.empty(cap_v, dtype=np.int64)
     offs[0] = 0
     nc = 0
-    for s in range(n):
+    for s in range(s_start, s_stop):
         cnt0 = _bfs_bounded(indptr, indices, s, half, dist0, queue)
         # copy visited set because queue is reused by the isometry check
         visited = queue[:cnt0].copy()

@@ -22,6 +22,8 @@ from . import _kernels
 from ._validate import InputError, as_edges, check_max_cycle_length
 from .graph import adjacency
 from .mesh import unique_edges
+from .progress import chunks
+from .threads import thread_map
 
 
 @dataclass(frozen=True)
@@ -105,7 +107,19 @@ def trivial_isometric_cycles(edges, n_points: int, *, max_length: int = 8) -> Cy
     if e.shape[0]:
         e = unique_edges(e)
     indptr, indices = adjacency(e, int(n_points))
-    offsets, verts = _kernels.isometric_cycles(indptr, indices, max_length)
+    n = int(n_points)
+    pieces = list(
+        thread_map(
+            lambda r: _kernels.isometric_cycles(indptr, indices, max_length, r[0], r[1]),
+            chunks(n, 16),  # starts of low index search more: many pieces
+        )
+    )
+    sizes = np.array([p[1].shape[0] for p in pieces], dtype=np.int64)
+    offsets = np.concatenate(
+        [np.zeros(1, np.int64)]
+        + [p[0][1:] + base for p, base in zip(pieces, np.cumsum(sizes) - sizes)]
+    )
+    verts = np.concatenate([p[1] for p in pieces])
     cs = CycleSet(offsets=offsets, vertices=verts)
     # canonical order: by length, then lexicographically by vertices
     lengths = cs.lengths

@@ -18,6 +18,7 @@ from scipy.spatial import cKDTree
 from . import _kernels
 from ._validate import as_points, check_k, check_not_degenerate, check_unique
 from .progress import bar, chunks
+from .threads import thread_map
 from .tolerance import DEFAULT, Tolerance
 
 
@@ -141,9 +142,16 @@ def localized_rng(
     shrink2 = (1.0 - tolerance.rtol) ** 2
     parts = []
     n = pts.shape[0]
+    pieces = list(chunks(n))
     with bar(n, "localized RNG", quiet) as pbar:
-        for lo, hi in chunks(n):
-            parts.append(_kernels.local_rng_pairs(pts, nb.indptr, nb.indices, shrink2, lo, hi))
+        for (lo, hi), part in zip(
+            pieces,
+            thread_map(
+                lambda r: _kernels.local_rng_pairs(pts, nb.indptr, nb.indices, shrink2, *r),
+                pieces,
+            ),
+        ):
+            parts.append(part)
             pbar.update(hi - lo)
     pairs = np.concatenate(parts) if parts else np.empty((0, 2), np.int64)
     # 1-D keys are an order of magnitude faster to deduplicate than rows

@@ -74,6 +74,7 @@ from scipy.sparse import csgraph
 
 from .graph import link_is_disk
 from .progress import log
+from .threads import thread_map
 
 #: CP-SAT deterministic time per second of ``seconds``: on the models first
 #: measured one deterministic unit took about four seconds of one core, on
@@ -627,14 +628,6 @@ def _crosses(conflicts, state: np.ndarray, answer: np.ndarray, cycles) -> bool:
     )
 
 
-def _threads() -> int:
-    """Threads for the components' first models: numba's thread count
-    (``NUMBA_NUM_THREADS``, the machine's cores by default)."""
-    import numba
-
-    return max(1, int(numba.get_num_threads()))
-
-
 def _settle(tab, state, comp, conflicts, lone, seconds, max_rounds, links, rings):
     """The closed models of a component, grown while proven infeasible.
 
@@ -734,17 +727,11 @@ def exact_selection(
     # alone on one worker, so the answers do not depend on the thread count
     given = state.copy()
     links_of = [set() for _ in comps]  # lazily (all up front: 2x slower, no better)
-    jobs = min(len(comps), _threads())
-    if jobs > 1:
-        from concurrent.futures import ThreadPoolExecutor
-
-        # the largest components first (the last to finish bounds the time)
-        order = sorted(range(len(comps)), key=lambda i: (-len(comps[i]), i))
-        with ThreadPoolExecutor(jobs) as pool:
-            done = dict(zip(order, pool.map(lambda i: settle(comps[i], links_of[i]), order)))
-        firsts = [done[i] for i in range(len(comps))]
-    else:
-        firsts = [settle(comp, links) for comp, links in zip(comps, links_of)]
+    # the largest components first (the last to finish bounds the time)
+    order = sorted(range(len(comps)), key=lambda i: (-len(comps[i]), i))
+    firsts = list(
+        thread_map(lambda i: settle(comps[i], links_of[i]), range(len(comps)), order=order)
+    )
     # then in order: the answers taken, the open models where no closed
     # answer came
     for comp, links, first in zip(comps, links_of, firsts):

@@ -202,13 +202,13 @@ def test_components_solved_side_by_side_match_one_at_a_time(monkeypatch):
     crosses the first one taken and is solved again next to it: face 4 is
     forbidden, and the open model keeps three faces.  One thread or two:
     the same selection and report."""
-    from sr33 import selection
+    from sr33 import selection, threads
 
     inc = _tetrahedra_incidence(2)
     conflicts = {0: [4], 4: [0]}
     out = []
-    for threads in (1, 2):
-        monkeypatch.setattr(selection, "_threads", lambda threads=threads: threads)
+    for n in (1, 2):
+        monkeypatch.setattr(threads, "thread_count", lambda n=n: n)
         state = np.zeros(8, dtype=np.int64)
         report = selection.exact_selection(inc, state, np.arange(8), conflicts)
         out.append((state.tolist(), report))
