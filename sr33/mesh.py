@@ -28,7 +28,7 @@ from scipy import sparse
 from scipy.sparse import csgraph
 from scipy.spatial import ConvexHull, QhullError
 
-from . import _intersect
+from . import _edges, _intersect
 
 SQRT3_2 = float(np.sqrt(3.0) / 2.0)  # Condition III-ii: shorter edges below this times the longest
 
@@ -193,21 +193,19 @@ def edge_incidence(pairs, face, n: int | None = None) -> EdgeIncidence:
     f = np.asarray(face, dtype=np.int64)
     n = int(p.max()) + 1 if n is None and p.size else int(n or 0)
     n = max(n, 1)
-    key = edge_keys(p[:, 0], p[:, 1], n)
-    order = np.argsort(key, kind="stable")
-    ks = key[order]
-    first = np.r_[True, ks[1:] != ks[:-1]] if ks.size else np.zeros(0, dtype=bool)
-    start = np.flatnonzero(first)
-    edge_of = np.empty(p.shape[0], dtype=np.int64)
-    edge_of[order] = np.cumsum(first) - 1
-    uniq = ks[start]
+    lo = np.minimum(p[:, 0], p[:, 1])
+    hi = np.maximum(p[:, 0], p[:, 1])
+    if p.size and (lo.min() < 0 or hi.max() >= n):
+        raise ValueError(f"edge_incidence: vertex indices must lie in [0, {n})")
+    # the stable order of the keys min * n + max, in linear time
+    order, edge_of, start = _edges.group_sides(lo, hi, n)
     return EdgeIncidence(
-        edges=np.stack([uniq // n, uniq % n], axis=1).reshape(-1, 2),
-        counts=np.diff(np.r_[start, ks.size]).astype(np.int64),
+        edges=np.stack([lo[order[start]], hi[order[start]]], axis=1).reshape(-1, 2),
+        counts=np.diff(np.r_[start, p.shape[0]]).astype(np.int64),
         edge_of=edge_of,
         face=f,
         forward=p[:, 0] < p[:, 1],
-        order=order.astype(np.int64),
+        order=order,
         start=start.astype(np.int64),
     )
 

@@ -226,3 +226,27 @@ def test_delaunay_triangles_are_delaunay_ccw_and_canonical_on_ties(which):
     r2 = ux * ux + uy * uy
     dist2 = ((p[None] - centre[:, None]) ** 2).sum(-1)
     assert (dist2 >= r2[:, None] - 1e-9).all()
+
+
+def test_edge_incidence_orders_sides_as_a_stable_sort_of_their_keys():
+    """The linear-time grouping (sr33._edges) gives what a stable argsort of
+    the keys min * n + max gives: the edges, their uses in order, each
+    side's edge; repeated sides and loops (a == b) included."""
+    from sr33.mesh import edge_incidence
+
+    rng = np.random.default_rng(7)
+    for trial in range(100):
+        n = int(rng.integers(1, 40))
+        p = rng.integers(0, n, (int(rng.integers(0, 200)), 2))
+        inc = edge_incidence(p, np.arange(p.shape[0]), n)
+        key = p.min(axis=1) * n + p.max(axis=1)
+        order = np.argsort(key, kind="stable")
+        uniq, first, counts = np.unique(key[order], return_index=True, return_counts=True)
+        assert np.array_equal(inc.order, order), trial
+        assert np.array_equal(inc.start, first) and np.array_equal(inc.counts, counts)
+        assert np.array_equal(inc.edges, np.stack([uniq // n, uniq % n], axis=1).reshape(-1, 2))
+        assert np.array_equal(key, uniq[inc.edge_of])
+    import pytest
+
+    with pytest.raises(ValueError, match=r"vertex indices must lie in \[0, 3\)"):
+        edge_incidence([[0, 3]], [0], 3)

@@ -467,9 +467,17 @@ def _nearest_sample(tv, e, w, snap, pts, patches, max_sweeps: int = 500):
     a = np.r_[e[:, 0], e[:, 1]]
     b = np.r_[e[:, 1], e[:, 0]]
     ww = np.r_[w, w]
+    # the directed edges grouped by the vertex offering (b): a sweep reads
+    # only the edges of the vertices changed in the sweep before
+    by_b = np.argsort(b, kind="stable")
+    first_of = np.searchsorted(b[by_b], np.arange(m + 1))
     active = np.ones(m, dtype=bool)
     for _ in range(max_sweeps):
-        sel = np.flatnonzero(active[b] & (label[b] >= 0) & (label[b] != label[a]))
+        offer = np.flatnonzero(active)
+        count = first_of[offer + 1] - first_of[offer]
+        at = np.repeat(first_of[offer] - np.cumsum(count) + count, count) + np.arange(count.sum())
+        sel = by_b[at]
+        sel = sel[(label[b[sel]] >= 0) & (label[b[sel]] != label[a[sel]])]
         if sel.size == 0:
             break
         va, vb, cand = a[sel], b[sel], label[b[sel]]
