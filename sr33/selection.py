@@ -35,8 +35,12 @@ cycles fixed next to them), with the rest of the selection held fixed:
   the component held fixed, the cycles sharing a sample with the model
   are freed and it is solved again (up to ``rings`` times): on input that
   does not conform, a face decided on its own (no candidate competes for
-  its edges) can be what makes closing impossible.  Only then the open
-  model, over the component itself.
+  its edges) can be what makes closing impossible.  Still infeasible, the
+  component is repaired round each cluster of its defects (open or
+  overloaded edges, pinched samples of the selection given), a window at
+  a time: the window's closed models, else its open model.  Out of time
+  instead, the open model of the whole component (and the windows of at
+  most half of it).
 
 Components are solved side by side first (one thread each, up to numba's
 thread count): their models read disjoint parts of the selection, CP-SAT
@@ -656,6 +660,72 @@ def _settle(tab, state, comp, conflicts, lone, seconds, max_rounds, links, rings
     return found, prov, cuts, took, best, cur, ring
 
 
+def _open_model(tab, state, cycles, conflicts, lone, seconds, max_rounds, links):
+    """The open model of ``cycles``; its answer is taken into ``state`` when
+    it is better (open edges and strays, then area).  Returns (taken,
+    proven, cuts)."""
+    outside = _touches_outside(tab, state, cycles)
+    best, prov, cuts = _solve_component(
+        tab, state, cycles, conflicts, lone, seconds, max_rounds, links, True, outside, False
+    )
+    if best is None:
+        return False, prov, cuts
+    edges_, verts_ = _extent(tab, cycles)
+    before = _score(tab, state, cycles, edges_, verts_, lone)
+    if _bubbles(tab, state, cycles, outside) or _score(
+        tab, best, cycles, edges_, verts_, lone
+    ).better_than(before, False):
+        state[cycles] = best[cycles]
+        return True, prov, cuts
+    return False, prov, cuts
+
+
+def _defect_windows(tab, state, comp, lone) -> list[list[int]]:
+    """The cycles of ``comp`` round each cluster of its defects in ``state``.
+
+    Defects are the samples of an edge used once (but not one lying in a
+    single candidate) or more than twice, and samples whose link is not a
+    disk; samples sharing a cycle of ``comp`` are one cluster.  A window is
+    the cluster's cycles and every cycle of ``comp`` sharing a sample with
+    them.  Clusters come in the order of their smallest sample.
+    """
+    inside = set(comp)
+    edges_, verts = _extent(tab, comp)
+    bad = set()
+    n = tab.n_points
+    keys = np.empty_like(tab.edge_keys)
+    keys[tab.edge_order] = tab.edge_keys
+    for e in edges_:
+        use = int(sum(1 for c in tab.cycles_at_edge(e) if state[c] == 1))
+        if (use == 1 and e not in lone) or use > 2:
+            bad.update((int(keys[e] // n), int(keys[e] % n)))
+    bad.update(v for v in verts if not _link_ok(tab, state, v))
+    if not bad:
+        return []
+    bad_sorted = sorted(bad)
+    rows, cols, seed = [], [], []
+    for v in bad_sorted:
+        mine = [int(tab.corner_owner[k]) for k in tab.corners_at(v)]
+        seed.append(sorted(c for c in mine if c in inside))
+    by_cycle: dict[int, int] = {}
+    for i, cs in enumerate(seed):
+        for c in cs:
+            j = by_cycle.setdefault(c, i)
+            rows.append(i)
+            cols.append(j)
+    g = sparse.csr_matrix(
+        (np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(len(bad_sorted),) * 2
+    )
+    ncomp, labels = csgraph.connected_components(g, directed=False)
+    first = [int(np.flatnonzero(labels == j)[0]) for j in range(ncomp)]
+    windows = []
+    for j in sorted(range(ncomp), key=lambda j: first[j]):
+        core = sorted({c for i in np.flatnonzero(labels == j) for c in seed[i]})
+        if core:
+            windows.append([c for c in _ring(tab, core) if c in inside])
+    return windows
+
+
 def exact_selection(
     incidence: Incidence,
     state: np.ndarray,
@@ -752,20 +822,36 @@ def exact_selection(
                 proven += int(prov)
                 grown += int(ring > 0)
             continue
-        # no closed answer: the open model over the component itself
-        outside = _touches_outside(tab, state, comp)
-        best, prov, cut = _solve_component(
-            tab, state, comp, conflicts, lone, seconds, max_rounds, links, True, outside, False
-        )
-        cuts += cut
-        if best is None:
-            continue
-        edges_, verts_ = _extent(tab, comp)
-        before = _score(tab, state, comp, edges_, verts_, lone)
-        if _bubbles(tab, state, comp, outside) or _score(
-            tab, best, comp, edges_, verts_, lone
-        ).better_than(before, False):
-            state[comp] = best[comp]
-            improved += 1
-            proven += int(prov)
+        # no closed answer for the whole, proven: it is repaired round each of its
+        # defects (open or overloaded edges, pinched samples of the
+        # selection in ``state``), a window at a time: the closed models
+        # (grown while infeasible), else the open model of the window.  A
+        # component too large for one model (a sparse scan: thousands of
+        # cycles, out of time) closes where it can and opens least elsewhere
+        taken = []
+        windows = _defect_windows(tab, state, comp, lone)
+        if not prov:
+            # out of time rather than infeasible: a window of more than half
+            # the component would run out of time too (wedge: one window of
+            # 878 of 947 cycles); with none smaller, the open model of the
+            # whole, as before
+            windows = [w for w in windows if 2 * len(w) <= len(comp)] or [comp]
+        for win in windows:
+            if len(win) < len(comp):  # the component's own closed models ran
+                found, prov, cut, took, best, cur, ring = settle(win, links)
+                cuts += cut
+                if found:
+                    if took:
+                        state[cur] = best[cur]
+                        taken.append(prov)
+                        grown += int(ring > 0)
+                    continue
+            took, prov, cut = _open_model(
+                tab, state, win, conflicts, lone, seconds, max_rounds, links
+            )
+            cuts += cut
+            if took:
+                taken.append(prov)
+        improved += int(bool(taken))
+        proven += int(bool(taken) and all(taken))
     return ExactReport(len(comps), improved, proven, cuts, grown)

@@ -96,8 +96,9 @@ def test_a_closed_model_proven_infeasible_skips_the_levels_model(monkeypatch):
     needs every edge twice, and each page's two other edges lie in it alone, so
     the closed model is infeasible -- proven at once, with lazy bubble cuts.
     The model with levels up front has the same constraints and more, and is
-    not run; the open model follows and the fallback's two pages stand
-    (cheburashka: two of five components, 0.2 s)."""
+    not run; there is nothing round the pages to free, and the fallback's two
+    pages have no defect to repair (their open edges lie in one candidate
+    each: a true boundary), so no open model runs and they stand."""
     solves = _record_solves(monkeypatch)
     pts = np.array(
         [[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, -0.5, 0.8], [0.5, -0.5, -0.8]], dtype=float
@@ -107,8 +108,8 @@ def test_a_closed_model_proven_infeasible_skips_the_levels_model(monkeypatch):
     assert len(cyc) == 3
     sel = backtracking(pts, e, cyc)
     calls = [(g["allow_open"], g["levels"], out[0] is not None, out[1]) for g, out in solves]
-    # closed: no answer, proven; open: an answer, proven optimal
-    assert calls == [(False, False, False, True), (True, False, True, True)]
+    # closed: no answer, proven; nothing else
+    assert calls == [(False, False, False, True)]
     assert sel.success and len(sel.faces) == 2 and sel.exact.components == 1
 
 
@@ -200,8 +201,9 @@ def test_components_solved_side_by_side_match_one_at_a_time(monkeypatch):
     (a conflict).  Both first models are solved next to the selection given
     (nothing), so both answers close their tetrahedron; the second answer
     crosses the first one taken and is solved again next to it: face 4 is
-    forbidden, and the open model keeps three faces.  One thread or two:
-    the same selection and report."""
+    forbidden, no closed answer is left, and the selection given (nothing,
+    so no open edge or pinched sample to repair) stands.  One thread or
+    two: the same selection and report."""
     from sr33 import selection, threads
 
     inc = _tetrahedra_incidence(2)
@@ -214,5 +216,5 @@ def test_components_solved_side_by_side_match_one_at_a_time(monkeypatch):
         out.append((state.tolist(), report))
     assert out[0] == out[1]
     state, report = out[0]
-    assert state == [1, 1, 1, 1, 0, 1, 1, 1]
-    assert (report.components, report.improved) == (2, 2)
+    assert state == [1, 1, 1, 1, 0, 0, 0, 0]
+    assert (report.components, report.improved) == (2, 1)
