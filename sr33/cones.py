@@ -293,15 +293,19 @@ def flip_sharper(points, triangles, seeds, *, rounds: int = 20) -> np.ndarray:
     if tri.shape[0] < 2 or seeds.shape[0] == 0:
         return tri
     pts = np.asarray(points, dtype=np.float64)
+
+    def ring(mask):  # the samples of the triangles with a sample in ``mask``
+        out = mask.copy()
+        out[tri[np.any(mask[tri], axis=1)].ravel()] = True
+        return out
+
     near = np.zeros(pts.shape[0], dtype=bool)
     near[seeds] = True
-    for _ in range(2):  # two rings round the seeds
-        near[tri[np.any(near[tri], axis=1)].ravel()] = True
+    near = ring(ring(near))  # two rings round the seeds
     # the triangles a flip can read: those with a sample next to a near one
     # (a flip joins two neighbours of a near sample, so every neighbour of a
     # near sample stays in this zone; the crossing test reads all triangles)
-    zone = near.copy()
-    zone[tri[np.any(near[tri], axis=1)].ravel()] = True
+    zone = ring(near)
     zone_tri = np.flatnonzero(np.any(zone[tri], axis=1))
     owner: dict[tuple[int, int], int] = {}
     for i, (a, b, c) in zip(zone_tri.tolist(), tri[zone_tri].tolist()):

@@ -75,6 +75,19 @@ class CycleSet:
         return CycleSet(offsets=offsets, vertices=verts.astype(np.int64))
 
 
+def concat(*sets: CycleSet) -> CycleSet:
+    """The cycles of every set, in the order given."""
+    base = np.cumsum([0] + [len(cs.vertices) for cs in sets[:-1]])
+    return CycleSet(
+        offsets=np.concatenate(
+            [np.zeros(1, np.int64)] + [cs.offsets[1:] + b for cs, b in zip(sets, base)]
+        ).astype(np.int64),
+        vertices=np.concatenate([np.zeros(0, np.int64)] + [cs.vertices for cs in sets]).astype(
+            np.int64
+        ),
+    )
+
+
 def trivial_isometric_cycles(edges, n_points: int, *, max_length: int = 8) -> CycleSet:
     """TrivialIsometricCycles(RNG, k): Algorithm 3, the small isometric cycles.
 
@@ -108,19 +121,13 @@ def trivial_isometric_cycles(edges, n_points: int, *, max_length: int = 8) -> Cy
         e = unique_edges(e)
     indptr, indices = adjacency(e, int(n_points))
     n = int(n_points)
-    pieces = list(
-        thread_map(
-            lambda r: _kernels.isometric_cycles(indptr, indices, max_length, r[0], r[1]),
+    cs = concat(
+        *thread_map(
+            lambda r: CycleSet(*_kernels.isometric_cycles(indptr, indices, max_length, *r)),
             chunks(n, 16),  # starts of low index search more: many pieces
         )
     )
-    sizes = np.array([p[1].shape[0] for p in pieces], dtype=np.int64)
-    offsets = np.concatenate(
-        [np.zeros(1, np.int64)]
-        + [p[0][1:] + base for p, base in zip(pieces, np.cumsum(sizes) - sizes)]
-    )
-    verts = np.concatenate([p[1] for p in pieces])
-    cs = CycleSet(offsets=offsets, vertices=verts)
+    offsets, verts = cs.offsets, cs.vertices
     # canonical order: by length, then lexicographically by vertices
     lengths = cs.lengths
     if len(cs) == 0:

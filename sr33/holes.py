@@ -39,7 +39,7 @@ from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
 from .backtracking import links_are_disks
-from .cycles import CycleSet
+from .cycles import CycleSet, concat
 from .graph import cycle_edges
 from .mesh import edge_keys, self_intersections
 
@@ -92,14 +92,6 @@ def _link_pieces(prev, nxt) -> dict[int, int]:
         if ra != rb:
             parent[max(ra, rb)] = min(ra, rb)
     return {x: find(x) for x in list(parent)}
-
-
-def concat(a: CycleSet, b: CycleSet) -> CycleSet:
-    """The cycles of ``a`` followed by those of ``b``."""
-    return CycleSet(
-        offsets=np.concatenate([a.offsets, a.offsets[-1] + b.offsets[1:]]).astype(np.int64),
-        vertices=np.concatenate([a.vertices, b.vertices]).astype(np.int64),
-    )
 
 
 def face_links(n: int, faces: CycleSet) -> np.ndarray:

@@ -18,9 +18,9 @@ from scipy.spatial import cKDTree
 from ._validate import InputError, as_points, check_k, check_max_cycle_length, check_not_degenerate
 from .backtracking import backtracking
 from .cones import attach_cones, ring_centres
-from .cycles import CycleSet, trivial_isometric_cycles
+from .cycles import CycleSet, concat, trivial_isometric_cycles
 from .graph import cycle_edges
-from .holes import HoleLoops, concat, crossing_faces, face_links, hole_loops, uncovered, unpinch
+from .holes import HoleLoops, crossing_faces, face_links, hole_loops, uncovered, unpinch
 from .jit import compile_notice
 from .mesh import edge_keys, self_intersections
 from .patches import stray_clusters, stray_patches

@@ -142,7 +142,8 @@ class _Tables:
     corner_owner: np.ndarray
     corner_prev: np.ndarray
     corner_next: np.ndarray
-    edge_keys: np.ndarray  # a * n + b of every edge (a < b), ascending
+    edges: np.ndarray  # (m, 2) the edges (a < b), by id
+    edge_keys: np.ndarray  # a * n + b of every edge, ascending
     edge_order: np.ndarray  # edge ids in that order
     n_points: int
     cost: np.ndarray  # per cycle: its quantized area, the objective's last term
@@ -214,6 +215,7 @@ def _tables(inc: Incidence) -> _Tables:
         inc.corner_owner,
         inc.corner_prev,
         inc.corner_next,
+        edges,
         keys[order],
         order,
         inc.n_points,
@@ -247,13 +249,16 @@ class _Score:
         return key < (old.open + old.strays, old.open_lone, old.area)
 
 
+def _uses(tab: _Tables, state: np.ndarray, edges_) -> dict[int, int]:
+    """How many selected cycles use each of ``edges_``."""
+    return {e: int(sum(1 for c in tab.cycles_at_edge(e) if state[c] == 1)) for e in edges_}
+
+
 def _score(tab: _Tables, state: np.ndarray, cycles, edges_, verts, lone) -> _Score:
     """(overloaded, open, open true-boundary edges, -Euler characteristic,
     strays, quantized area) of ``state`` over a region: the model's
     objective, lexicographic."""
-    use = {}
-    for e in edges_:
-        use[e] = int(sum(1 for c in tab.cycles_at_edge(e) if state[c] == 1))
+    use = _uses(tab, state, edges_)
     over = sum(1 for u in use.values() if u > 2)
     open_ = sum(1 for e, u in use.items() if u == 1 and e not in lone)
     open_lone = sum(1 for e, u in use.items() if u == 1 and e in lone)
@@ -579,9 +584,8 @@ def _extent(tab: _Tables, cycles) -> tuple[list[int], list[int]]:
 
 def _ring(tab: _Tables, cycles) -> list[int]:
     """``cycles`` and every cycle with a sample of theirs, sorted."""
-    _, verts = _extent(tab, cycles)
     out = set(cycles)
-    for v in verts:
+    for v in {int(v) for c in cycles for v in tab.cycle_vertices[c]}:
         out.update(int(c) for c in tab.corner_owner[tab.corners_at(v)])
     return sorted(out)
 
@@ -595,13 +599,7 @@ def _closed(tab, state, cycles, conflicts, lone, seconds, max_rounds, links):
     infeasible --, cuts, the answer is better than the selection in
     ``state`` and to be taken, the answer or None).
     """
-    edges_, verts_ = _extent(tab, cycles)
-    before = _score(tab, state, cycles, edges_, verts_, lone)
-    # a selection given with a detached bubble is beaten by any valid answer
-    # (they have none): its extra spheres raise the Euler characteristic the
-    # comparison would otherwise prefer
     outside = _touches_outside(tab, state, cycles)
-    bubbled = bool(_bubbles(tab, state, cycles, outside))
     cuts = 0
     best, prov = None, False
     # lazy bubble cuts first (fast: most models are proven optimal in a few
@@ -617,8 +615,20 @@ def _closed(tab, state, cycles, conflicts, lone, seconds, max_rounds, links):
             break
     if best is None:
         return False, prov, cuts, False, None
-    took = bubbled or _score(tab, best, cycles, edges_, verts_, lone).better_than(before, True)
-    return True, prov, cuts, took, best
+    return True, prov, cuts, _improves(tab, state, best, cycles, lone, outside, True), best
+
+
+def _improves(tab, state, answer, cycles, lone, outside: bool, closed: bool) -> bool:
+    """Whether ``answer`` is to replace ``state`` over ``cycles`` (the order
+    of :meth:`_Score.better_than`).  A selection given with a detached
+    bubble is beaten by any valid answer (they have none): its extra
+    spheres raise the Euler characteristic the comparison would otherwise
+    prefer."""
+    if _bubbles(tab, state, cycles, outside):
+        return True
+    edges_, verts = _extent(tab, cycles)
+    before = _score(tab, state, cycles, edges_, verts, lone)
+    return _score(tab, answer, cycles, edges_, verts, lone).better_than(before, closed)
 
 
 def _crosses(conflicts, state: np.ndarray, answer: np.ndarray, cycles) -> bool:
@@ -668,16 +678,10 @@ def _open_model(tab, state, cycles, conflicts, lone, seconds, max_rounds, links)
     best, prov, cuts = _solve_component(
         tab, state, cycles, conflicts, lone, seconds, max_rounds, links, True, outside, False
     )
-    if best is None:
+    if best is None or not _improves(tab, state, best, cycles, lone, outside, False):
         return False, prov, cuts
-    edges_, verts_ = _extent(tab, cycles)
-    before = _score(tab, state, cycles, edges_, verts_, lone)
-    if _bubbles(tab, state, cycles, outside) or _score(
-        tab, best, cycles, edges_, verts_, lone
-    ).better_than(before, False):
-        state[cycles] = best[cycles]
-        return True, prov, cuts
-    return False, prov, cuts
+    state[cycles] = best[cycles]
+    return True, prov, cuts
 
 
 def _defect_windows(tab, state, comp, lone) -> list[list[int]]:
@@ -692,13 +696,9 @@ def _defect_windows(tab, state, comp, lone) -> list[list[int]]:
     inside = set(comp)
     edges_, verts = _extent(tab, comp)
     bad = set()
-    n = tab.n_points
-    keys = np.empty_like(tab.edge_keys)
-    keys[tab.edge_order] = tab.edge_keys
-    for e in edges_:
-        use = int(sum(1 for c in tab.cycles_at_edge(e) if state[c] == 1))
+    for e, use in _uses(tab, state, edges_).items():
         if (use == 1 and e not in lone) or use > 2:
-            bad.update((int(keys[e] // n), int(keys[e] % n)))
+            bad.update(int(v) for v in tab.edges[e])
     bad.update(v for v in verts if not _link_ok(tab, state, v))
     if not bad:
         return []

@@ -3,8 +3,8 @@
 import numpy as np
 
 from sr33 import reconstruct
-from sr33.cycles import CycleSet
-from sr33.holes import concat, face_links, hole_loops, uncovered, unpinch
+from sr33.cycles import CycleSet, concat
+from sr33.holes import face_links, hole_loops, uncovered, unpinch
 from sr33.io import read_points
 from sr33.samplers import cube_lattice
 from sr33.triangulate import triangulate
