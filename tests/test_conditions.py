@@ -247,20 +247,24 @@ def test_chords_stand_for_geodesics_only_where_the_patch_is_flat_between():
 
 
 @pytest.mark.parametrize(
-    "height, crossings, flipped",
+    "height, crossings, exact, flipped",
     [
-        (0.3, 50, True),  # opposite angles 2 x 118 degrees: plainly not Delaunay
-        (0.4913, 50, False),  # 2 x 91 degrees: within FLIP_MARGIN of pi, the labels stand
-        (0.4913, 3, True),  # ... unless the edge is a near tie
-        (0.6, 50, False),  # 2 x 80 degrees: Delaunay
+        (0.3, 50, False, True),  # opposite angles 2 x 118 degrees: plainly not Delaunay
+        (0.4913, 50, False, False),  # 2 x 91 degrees: within FLIP_MARGIN of pi, the labels stand
+        (0.4913, 3, False, True),  # ... unless the edge is a near tie
+        (0.4913, 50, True, True),  # ... or its lengths are exact (one flat face)
+        (0.6, 50, True, False),  # 2 x 80 degrees: Delaunay
     ],
 )
-def test_edges_plainly_not_delaunay_are_flipped(height, crossings, flipped):
+def test_edges_plainly_not_delaunay_are_flipped(height, crossings, exact, flipped):
     """The labels' DT_M edge (a, b) with triangles (a, b, c) and (a, b, d),
     c and d at ``height`` on either side of its middle: the angle test
     flips it to (c, d) when the angles at c and d exceed π by more than
     FLIP_MARGIN (a labelling error where samples crowd, as round a cone's
-    designed fan), or by anything on a near tie; a Delaunay edge stays."""
+    designed fan), or by anything on a near tie or where the five lengths
+    are exact (chords on one flat face: there DT_M is the plane's Delaunay
+    triangulation, and a turned block_two_holes' labels had kept an edge
+    2 degrees from it, a false 0.984); a Delaunay edge stays."""
     from sr33.validators.conditions import FLIP_MARGIN, _flip_to_delaunay
 
     assert FLIP_MARGIN == 5.0
@@ -269,10 +273,14 @@ def test_edges_plainly_not_delaunay_are_flipped(height, crossings, flipped):
     cross = np.array([crossings, 40, 40, 40, 40])
     tri = np.array([[0, 1, 2], [0, 1, 3]])
 
-    def geodesics(pairs):
-        return np.linalg.norm(pts[pairs[:, 0]] - pts[pairs[:, 1]], axis=1)
+    class Geodesics:
+        def __call__(self, pairs):
+            return np.linalg.norm(pts[pairs[:, 0]] - pts[pairs[:, 1]], axis=1)
 
-    e, _, t = _flip_to_delaunay(pts, (edges, cross, tri), geodesics)
+        def exact(self, pairs):
+            return np.full(pairs.shape[0], exact)
+
+    e, _, t = _flip_to_delaunay(pts, (edges, cross, tri), Geodesics())
     got = {tuple(x) for x in e.tolist()}
     assert ((2, 3) in got, (0, 1) in got) == (flipped, not flipped)
     assert len(got) == 5

@@ -321,6 +321,7 @@ class _Geodesics:
         self._solver = None
         self._vertex_of = None
         self._known: dict[int, float] = {}
+        self._chords: set[int] = set()  # pairs whose chord lies on the surface
 
     def _solver_mesh(self):
         """The solver and each sample's vertex: the coarsest of one, a half and
@@ -344,11 +345,19 @@ class _Geodesics:
         code = pairs[:, 0] * n + pairs[:, 1]
         todo = np.unique(code[[c not in self._known for c in code.tolist()]])
         if todo.size:
-            got = self._compute(np.stack([todo // n, todo % n], axis=1))
+            got, chord = self._compute(np.stack([todo // n, todo % n], axis=1))
             self._known.update(zip(todo.tolist(), got.tolist()))
+            self._chords.update(todo[chord].tolist())
         return np.array([self._known[c] for c in code.tolist()], dtype=np.float64)
 
-    def _compute(self, edges: np.ndarray) -> np.ndarray:
+    def exact(self, pairs: np.ndarray) -> np.ndarray:
+        """Which of the pairs ``pairs`` (computed before) have an exact length:
+        their chord lies on the surface, so it is their geodesic."""
+        n = self.pts.shape[0]
+        code = pairs[:, 0] * n + pairs[:, 1]
+        return np.array([c in self._chords for c in code.tolist()], dtype=bool)
+
+    def _compute(self, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         from sr33.progress import bar
 
         from .fidelity import distance_to_surface
@@ -378,7 +387,9 @@ class _Geodesics:
                 )
                 length[i] = max(trace, chord[i])
                 pbar.update(1)
-        return length
+        flat = np.ones(edges.shape[0], dtype=bool)
+        flat[curved] = False
+        return length, flat
 
 
 def _patch_sets(tv: np.ndarray, tf: np.ndarray, degrees: float):
@@ -628,9 +639,12 @@ def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8):
     triangle developed flat); when they sum to more than π the edge is not
     locally Delaunay and is flipped to (c, d) (Lawson's flip; a triangle
     takes part in one flip a round; never onto a pair that is already an
-    edge).  A near tie (:data:`TIE_CROSSINGS`) is flipped at any excess
-    over π (a sum within 1e-9 of π, truly cocircular samples, keeps the
-    labelled diagonal); any other edge only at an excess over
+    edge).  A near tie (:data:`TIE_CROSSINGS`), and an edge whose five
+    lengths are all exact (chords that lie on the surface: the quad lies on
+    one flat face, where DT_M is the plane's Delaunay triangulation), is
+    flipped at
+    any excess over π (a sum within 1e-9 of π, truly cocircular samples,
+    keeps the labelled diagonal); any other edge only at an excess over
     ``FLIP_MARGIN``: there the labels took a diagonal that is plainly not
     Delaunay (Dijkstra's distances along the mesh edges run a few percent
     long, which moves the cells' borders where samples crowd, as round a
@@ -651,11 +665,12 @@ def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8):
             axis=1,
         )
         ab, ac, bc, ad, bd = geodesics(pairs).reshape(5, -1)
+        exact = geodesics.exact(pairs).reshape(5, -1).all(axis=0)
         code = edges[:, 0] * n + edges[:, 1]
         tie = cross[np.searchsorted(code, q[:, 0] * n + q[:, 1])] <= TIE_CROSSINGS
         excess = _angle(ac, bc, ab) + _angle(ad, bd, ab) - np.pi
         cd = np.minimum(q[:, 2], q[:, 3]) * n + np.maximum(q[:, 2], q[:, 3])
-        bar = np.where(tie, 1e-9, math.radians(FLIP_MARGIN))
+        bar = np.where(tie | exact, 1e-9, math.radians(FLIP_MARGIN))
         flips = q[(excess > bar) & ~np.isin(cd, code)]
         if flips.size == 0:
             break
