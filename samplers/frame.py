@@ -12,18 +12,28 @@ ratio 0.97, in 337 s) where the upright cube has none (0.707, 0.5 s).
 :func:`model_frame` reads the model's directions from its B-rep (the
 normals of planar faces and the axes of cylinders, cones, tori and surfaces
 of revolution or extrusion, weighted by the faces' areas), groups parallel
-ones, and builds a frame from them:
+ones, finds its mirror planes (:func:`sr33.samplers.symmetry.mirror_normals`),
+and builds a frame from them:
 
 * its z axis is the heaviest direction (ties: all heaviest are tried), its
-  x axis the direction perpendicular to z that, with z and z × x, lines up
-  the most area (ties: the one the model is longest along, as a part lies
-  on a table, then the first in face order), or for a model with no
-  direction perpendicular to z (a cylinder, a cone) the x axis of z's
-  first surface; each direction points along the axis of its first axial
-  face (a cylinder's, a cone's: as the model was built), else away from
-  its largest planar face (the one the model would rest on), so the frame
-  turns with the model (rotating a B-rep keeps its faces' order,
-  orientation and parametrisation);
+  x axis a direction perpendicular to z, or a mirror's normal perpendicular
+  to z, or that normal turned a quarter about z, and each of these turned
+  half about z; of these frames the one that keeps the most mirrors (maps
+  the model's mirrors onto its own axes, or swaps two axes: a hexagonal
+  prism's vertex direction, a star's axis, not a frame lined up with one
+  of their sides), then lines up the most area with z, x and z × x, then
+  the most length of straight edges (a pyramid's base edges, not its
+  diagonals), then the one the model is longest along x (as a part lies
+  on a table), then reaches farther along +y and then +x from its centre
+  of mass (a star's point up, as it is drawn), then the first in face
+  order; for a model with no direction perpendicular to z (a cylinder, a
+  cone) x is the x axis of z's first surface; z points along the axis of
+  its first axial face (a cylinder's, a cone's: as the model was built),
+  else away from its largest planar face (the one the model would rest
+  on), so the frame turns with the model (rotating a B-rep keeps its
+  faces' order, orientation and parametrisation), and a symmetric model
+  turned any way is scanned in its upright frame or one its symmetry maps
+  there (a turned hexagonal or star prism: the upright's scan rows);
 * the world axes are kept unless the model's frame lines up at least
   ``SWITCH`` (a quarter) of the surface area more than they do.  Every
   library shape built upright keeps them (the largest gain among the 14 is
@@ -31,9 +41,9 @@ ones, and builds a frame from them:
   off the axes lines up nothing with them, and a model without a planar or
   axial face (a sphere, a B-spline body) has no frame of its own.
 
-The frame's choice depends on areas and directions only (no float's last
-bit decides between frames: directions within ``TOL`` are one, weights are
-compared with a relative margin of 1e-9).
+The frame's choice depends on areas, lengths and directions only (no float's
+last bit decides between frames: directions within ``TOL`` are one, weights
+and lengths are compared with a relative margin of 1e-9).
 """
 
 from __future__ import annotations
@@ -45,6 +55,7 @@ import numpy as np
 from sr33.mesh import dot, norm
 
 from .faces import exact_bounds
+from .symmetry import mirror_normals, respected
 
 TOL = 1e-7  # directions whose cross product is shorter than this are parallel
 SWITCH = 0.25  # share of the area the model's frame must line up beyond the world's
@@ -154,6 +165,30 @@ def surface_directions(solid) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
+def line_directions(solid) -> tuple[np.ndarray, np.ndarray]:
+    """The unit directions and lengths of a B-rep's straight edges.
+
+    Parameters
+    ----------
+    solid : cadquery.Shape
+
+    Returns
+    -------
+    directions : (m, 3) float64
+    lengths : (m,) float64
+    """
+    dirs, lengths = [], []
+    for e in solid.Edges():
+        if e.geomType() != "LINE":
+            continue
+        d = np.subtract(e.endPoint().toTuple(), e.startPoint().toTuple())
+        length = float(norm(d))
+        if length > 0:
+            dirs.append(d / length)
+            lengths.append(length)
+    return np.array(dirs, dtype=np.float64).reshape(-1, 3), np.array(lengths, dtype=np.float64)
+
+
 def _parallel(a: np.ndarray, b: np.ndarray) -> bool:
     return float(norm(np.cross(a, b))) < TOL
 
@@ -187,9 +222,10 @@ def _aligned(axes: np.ndarray, groups) -> float:
     return sum(w for d, w, _ in groups if any(_parallel(a, d) for a in axes))
 
 
-def _frames(groups):
+def _frames(groups, mirrors: np.ndarray):
     """Candidate frames (rows x, y, z): z a heaviest direction, x a
-    direction perpendicular to it; for a model with no direction
+    direction perpendicular to it, or a mirror's normal perpendicular to it
+    or that normal turned a quarter about z; for a model with no direction
     perpendicular to z, the x of z's first surface (a cylinder's seam
     side), else the world axis least along z, made perpendicular."""
     top = max(w for _, w, _ in groups)
@@ -198,6 +234,8 @@ def _frames(groups):
             continue
         z = z / norm(z)
         across = [d for d, _, _ in groups if abs(float(dot(d, z))) < TOL]
+        flat = [m for m in mirrors if abs(float(dot(m, z))) < TOL]
+        across += flat + [np.cross(z, m) for m in flat]
         if not across and not np.isnan(ref).any() and abs(float(dot(ref, z))) < 1 - TOL:
             across = [ref]
         if not across:
@@ -207,6 +245,22 @@ def _frames(groups):
             x = x - float(dot(x, z)) * z
             x = x / norm(x)
             yield np.array([x, np.cross(z, x), z])
+            yield np.array([-x, -np.cross(z, x), z])  # the same, turned half about z
+
+
+def _before(a: tuple, b: tuple) -> bool:
+    """Whether the key ``a`` ranks before ``b``: compared term by term, the
+    larger first; floats within a relative ``_WEIGHT_TIE`` (absolute for
+    terms near 0) are equal, so that no last bit decides."""
+    for p, q in zip(a, b):
+        if isinstance(p, int):
+            if p != q:
+                return p > q
+            continue
+        scale = max(abs(p), abs(q), 1.0 if abs(p) + abs(q) < 1e-3 else 0.0)
+        if abs(p - q) > _WEIGHT_TIE * scale:
+            return p > q
+    return False
 
 
 def model_frame(solid) -> Frame:
@@ -237,16 +291,30 @@ def model_frame(solid) -> Frame:
         return Frame(WORLD.copy(), 0.0, 0.0)
     groups = _groups(dirs, areas, refs, planar)
     world = _aligned(WORLD, groups)
-    best, best_w, best_x = None, -1.0, 0.0
-    for axes in _frames(groups):
-        w = _aligned(axes, groups)
-        if w < best_w * (1 - _WEIGHT_TIE):
-            continue
+    mirrors = mirror_normals(solid)
+    line_dirs, line_len = line_directions(solid)
+    centre = np.asarray(solid.Center().toTuple(), dtype=np.float64)
+    size = float(norm(np.subtract(*exact_bounds(solid)[::-1])))
+    best, best_key = None, None
+    for axes in _frames(groups, mirrors):
         lo, hi = exact_bounds(in_frame(solid, axes))
-        x = float(hi[0] - lo[0])
-        # more area lined up; of equal ones the longest along x; then the first
-        if w > best_w * (1 + _WEIGHT_TIE) or x > best_x * (1 + _WEIGHT_TIE):
-            best, best_w, best_x = axes, w, x
+        c = axes @ centre
+        # more mirrors kept; more area lined up; more length of straight
+        # edges lined up; the longest along x; the model reaching farther
+        # along +y, then +x, from its centre of mass (which of a frame's half
+        # turns about z); the first
+        along = np.abs(line_dirs @ axes.T).max(axis=1) >= 1.0 - TOL if len(line_len) else []
+        key = (
+            respected(axes, mirrors),
+            _aligned(axes, groups),
+            float(line_len[along].sum()) if len(line_len) else 0.0,
+            float(hi[0] - lo[0]),
+            float((hi[1] - c[1]) - (c[1] - lo[1])) / size,
+            float((hi[0] - c[0]) - (c[0] - lo[0])) / size,
+        )
+        if best_key is None or _before(key, best_key):
+            best, best_key = axes, key
+    best_w = best_key[1] if best_key is not None else 0.0
     if best is None or best_w < world + SWITCH * total:
         return Frame(WORLD.copy(), world / total, world / total)
     return Frame(best, best_w / total, world / total)
@@ -276,4 +344,12 @@ def in_frame(solid, axes: np.ndarray):
     return cq.Shape.cast(BRepBuilderAPI_Transform(solid.wrapped, trsf, True).Shape())
 
 
-__all__ = ["Frame", "SWITCH", "TOL", "in_frame", "model_frame", "surface_directions"]
+__all__ = [
+    "Frame",
+    "SWITCH",
+    "TOL",
+    "in_frame",
+    "line_directions",
+    "model_frame",
+    "surface_directions",
+]
