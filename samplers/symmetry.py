@@ -22,6 +22,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .faces import exact_bounds
+
 TOL = 1e-6  # positions, lengths and areas are equal within this share of the model's size
 MAX_VERTICES = 400  # the vertex pairs tried: the first this many vertices (B-rep order)
 
@@ -37,9 +39,8 @@ def _entities(solid):
     fc = np.array([f.Center().toTuple() for f in faces], dtype=np.float64).reshape(-1, 3)
     fa = np.array([f.Area() for f in faces], dtype=np.float64)
     centre = np.asarray(solid.Center().toTuple(), dtype=np.float64)
-    bb = solid.BoundingBox()
-    size = float(np.hypot(np.hypot(bb.xlen, bb.ylen), bb.zlen))
-    return verts, (ec, el), (fc, fa), centre, size
+    lo, hi = exact_bounds(solid)
+    return verts, (ec, el), (fc, fa), centre, float(np.linalg.norm(hi - lo))
 
 
 def _maps_onto(points: np.ndarray, weights: np.ndarray | None, n, centre, tol, wtol) -> bool:
