@@ -43,14 +43,15 @@ def _entities(solid):
     return verts, (ec, el), (fc, fa), centre, float(np.linalg.norm(hi - lo))
 
 
-def _maps_onto(points: np.ndarray, weights: np.ndarray | None, n, centre, tol, wtol) -> bool:
-    """Whether reflecting ``points`` in the plane through ``centre`` with
-    unit normal ``n`` puts every point within ``tol`` of one of them whose
-    weight (a length, an area) is equal within ``wtol``, one to one."""
+def _maps_onto(points: np.ndarray, tree, weights, n, centre, tol, wtol) -> bool:
+    """Whether reflecting ``points`` (their tree ``tree``) in the plane
+    through ``centre`` with unit normal ``n`` puts every point within
+    ``tol`` of one of them whose weight (a length, an area; None: no
+    weights) is equal within ``wtol``, one to one."""
     if points.shape[0] == 0:
         return True
     image = points - 2.0 * ((points - centre) @ n)[:, None] * n
-    d, j = cKDTree(points).query(image)
+    d, j = tree.query(image)
     if d.max() > tol or np.unique(j).size != j.size:
         return False
     return weights is None or bool(np.abs(weights[j] - weights).max() <= wtol)
@@ -91,14 +92,25 @@ def mirror_normals(solid) -> np.ndarray:
     mid = 0.5 * (v[i][ok] + v[j][ok])
     # the plane bisecting the pair must hold the centre of mass
     n = n[np.abs(((centre - mid) * n).sum(axis=1)) <= tol]
+    # each direction is tried once (its sign made positive on its largest
+    # component, rounded well above TOL's spread); the first pair's sign kept
+    lead = np.argmax(np.abs(n), axis=1)
+    canon = n * np.sign(n[np.arange(n.shape[0]), lead])[:, None]
+    _, first = np.unique(np.round(canon, 6), axis=0, return_index=True)
+    n = n[np.sort(first)]
+    trees = [cKDTree(p) for p in (verts, ec, fc)]
+    # a quick cut, all directions at once: the first vertices' images must be vertices
+    for p in verts[:8]:
+        image = p - 2.0 * ((p - centre) @ n.T)[:, None] * n
+        n = n[trees[0].query(image)[0] <= tol]
     out: list[np.ndarray] = []
     for cand in n:
         if any(abs(float(cand @ m)) >= 1.0 - TOL for m in out):
             continue
         if (
-            _maps_onto(verts, None, cand, centre, tol, 0.0)
-            and _maps_onto(ec, el, cand, centre, tol, tol)
-            and _maps_onto(fc, fa, cand, centre, tol, tol * size)
+            _maps_onto(verts, trees[0], None, cand, centre, tol, 0.0)
+            and _maps_onto(ec, trees[1], el, cand, centre, tol, tol)
+            and _maps_onto(fc, trees[2], fa, cand, centre, tol, tol * size)
         ):
             out.append(cand)
     return np.array(out, dtype=np.float64).reshape(-1, 3)
