@@ -52,7 +52,7 @@ from .faces import (
     steps,
     whole_band,
 )
-from .repair import GAP, MOVABLE, Repaired, copies, repair, split_corners
+from .repair import GAP, MOVABLE, RETRY_BAD, Repaired, copies, repair, split_corners
 from .rings import HALVING_GAP, ring_positions
 from .samples import Samples
 
@@ -593,6 +593,9 @@ def repair_planar_faces(
                 frame=frame,
                 judge_frame=True,
                 max_edits=None if arcs else (FOLLOW_EDITS if follow else LINE_EDITS),
+                # straight edges only: every judged triangle is exact (the
+                # neighbours unfold isometrically), so any bad one is real
+                retry_bad=RETRY_BAD if arcs else 1,
             )
             # stuck: wider cells only round whole circles (on cutcube's face
             # whose scoop arc ends on the cube's edge they opened the
