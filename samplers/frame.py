@@ -245,7 +245,6 @@ def _frames(groups, mirrors: np.ndarray):
             x = x - float(dot(x, z)) * z
             x = x / norm(x)
             yield np.array([x, np.cross(z, x), z])
-            yield np.array([-x, -np.cross(z, x), z])  # the same, turned half about z
 
 
 def _before(a: tuple, b: tuple) -> bool:
@@ -300,20 +299,22 @@ def model_frame(solid) -> Frame:
         lo, hi = exact_bounds(in_frame(solid, axes))
         c = axes @ centre
         # more mirrors kept; more area lined up; more length of straight
-        # edges lined up; the longest along x; the model reaching farther
-        # along +y, then +x, from its centre of mass (which of a frame's half
-        # turns about z); the first
+        # edges lined up; the longest along x: the same for the frame turned
+        # half about z (x and y reversed, its bounds the mirror of these)
         along = np.abs(line_dirs @ axes.T).max(axis=1) >= 1.0 - TOL if len(line_len) else []
-        key = (
+        head = (
             respected(axes, mirrors),
             _aligned(axes, groups),
             float(line_len[along].sum()) if len(line_len) else 0.0,
             float(hi[0] - lo[0]),
-            float((hi[1] - c[1]) - (c[1] - lo[1])) / size,
-            float((hi[0] - c[0]) - (c[0] - lo[0])) / size,
         )
-        if best_key is None or _before(key, best_key):
-            best, best_key = axes, key
+        # then the model reaching farther along +y, then +x, from its centre
+        # of mass (which of the two half turns); then the first
+        reach = ((hi - c) - (c - lo))[:2] / size
+        for sign in (1.0, -1.0):
+            key = (*head, float(sign * reach[1]), float(sign * reach[0]))
+            if best_key is None or _before(key, best_key):
+                best, best_key = axes * np.array([[sign], [sign], [1.0]]), key
     best_w = best_key[1] if best_key is not None else 0.0
     if best is None or best_w < world + SWITCH * total:
         return Frame(WORLD.copy(), world / total, world / total)
