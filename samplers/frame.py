@@ -249,15 +249,11 @@ def _frames(groups, mirrors: np.ndarray):
 
 def _before(a: tuple, b: tuple) -> bool:
     """Whether the key ``a`` ranks before ``b``: compared term by term, the
-    larger first; floats within a relative ``_WEIGHT_TIE`` (absolute for
-    terms near 0) are equal, so that no last bit decides."""
+    larger first; its terms are counts and shares of the model's area or
+    size, and shares within ``_WEIGHT_TIE`` are equal, so that no last bit
+    decides."""
     for p, q in zip(a, b):
-        if isinstance(p, int):
-            if p != q:
-                return p > q
-            continue
-        scale = max(abs(p), abs(q), 1.0 if abs(p) + abs(q) < 1e-3 else 0.0)
-        if abs(p - q) > _WEIGHT_TIE * scale:
+        if abs(p - q) > _WEIGHT_TIE:
             return p > q
     return False
 
@@ -304,9 +300,9 @@ def model_frame(solid) -> Frame:
         along = np.abs(line_dirs @ axes.T).max(axis=1) >= 1.0 - TOL if len(line_len) else []
         head = (
             respected(axes, mirrors),
-            _aligned(axes, groups),
-            float(line_len[along].sum()) if len(line_len) else 0.0,
-            float(hi[0] - lo[0]),
+            _aligned(axes, groups) / total,
+            float(line_len[along].sum()) / size if len(line_len) else 0.0,
+            float(hi[0] - lo[0]) / size,
         )
         # then the model reaching farther along +y, then +x, from its centre
         # of mass (which of the two half turns); then the first
@@ -315,10 +311,10 @@ def model_frame(solid) -> Frame:
             key = (*head, float(sign * reach[1]), float(sign * reach[0]))
             if best_key is None or _before(key, best_key):
                 best, best_key = axes * np.array([[sign], [sign], [1.0]]), key
-    best_w = best_key[1] if best_key is not None else 0.0
-    if best is None or best_w < world + SWITCH * total:
+    share = best_key[1] if best_key is not None else 0.0
+    if best is None or share < (world + SWITCH * total) / total:
         return Frame(WORLD.copy(), world / total, world / total)
-    return Frame(best, best_w / total, world / total)
+    return Frame(best, share, world / total)
 
 
 def in_frame(solid, axes: np.ndarray):

@@ -716,10 +716,10 @@ def _defect_windows(tab, state, comp, lone) -> list[list[int]]:
     g = sparse.csr_matrix(
         (np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(len(bad_sorted),) * 2
     )
-    ncomp, labels = csgraph.connected_components(g, directed=False)
-    first = [int(np.flatnonzero(labels == j)[0]) for j in range(ncomp)]
+    _, labels = csgraph.connected_components(g, directed=False)
+    _, first = np.unique(labels, return_index=True)  # each cluster's smallest sample
     windows = []
-    for j in sorted(range(ncomp), key=lambda j: first[j]):
+    for j in np.argsort(first, kind="stable").tolist():
         core = sorted({c for i in np.flatnonzero(labels == j) for c in seed[i]})
         if core:
             windows.append([c for c in _ring(tab, core) if c in inside])

@@ -642,9 +642,8 @@ def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8):
     edge).  A near tie (:data:`TIE_CROSSINGS`), and an edge whose five
     lengths are all exact (chords that lie on the surface: the quad lies on
     one flat face, where DT_M is the plane's Delaunay triangulation), is
-    flipped at
-    any excess over π (a sum within 1e-9 of π, truly cocircular samples,
-    keeps the labelled diagonal); any other edge only at an excess over
+    flipped at any excess over π (a sum within 1e-9 of π, truly cocircular
+    samples, keeps the labelled diagonal); any other edge only at an excess over
     ``FLIP_MARGIN``: there the labels took a diagonal that is plainly not
     Delaunay (Dijkstra's distances along the mesh edges run a few percent
     long, which moves the cells' borders where samples crowd, as round a
