@@ -1043,3 +1043,68 @@ def test_a_frustums_samples_stay_on_its_surface():
     top = r.points[:, 2].max()
     assert top == pytest.approx(0.2, abs=1e-9)
     assert [x["kind"] for x in r.meta["repairs"]].count("cone rings") == 1
+
+
+def _pencil():
+    """A cylinder (radius 0.3, height 0.6) under a cone 0.5 high: the
+    cylinder's top rim is the cone's, its bottom rim the base disk's."""
+    import cadquery as cq
+
+    cyl = cq.Solid.makeCylinder(0.3, 0.6)
+    cone = cq.Solid.makeCone(0.3, 0.0, 0.5, pnt=cq.Vector(0, 0, 0.6))
+    return shapes.from_cad(cq.Solid(cyl.fuse(cone).clean().Solids()[0].wrapped), name="pencil")
+
+
+def test_a_cylinders_rim_on_a_cone_takes_its_other_rims_angles():
+    """A cylinder whose rims differ (the base's repair slid its rim; here
+    turned half a step) is laid out when the other rim's face is laid
+    after it (a cone): that rim takes the base rim's angles and the wall is
+    the lattice both span.  Before, the wall kept its scan rows and 58 of
+    a 3,000-sample pencil's wall samples broke III-ii."""
+    from sr33.samplers.layers import lattice_cylinder_faces
+    from sr33.samplers.samples import Samples
+
+    s = _pencil()
+    r = scan(s, target_points=1500, repair=False, quiet=True)
+    h = r.meta["spacing"]
+    p = r.points.copy()
+    radial = np.hypot(p[:, 0], p[:, 1])
+    base = np.isclose(p[:, 2], 0.0, atol=1e-9) & np.isclose(radial, 0.3, atol=1e-9)
+    turn = np.pi / base.sum()  # half a step
+    c, sn = np.cos(turn), np.sin(turn)
+    p[base, :2] = p[base, :2] @ np.array([[c, sn], [-sn, c]])
+    bag = Samples(p, r.line_id, r.face_id, r.on_feature)
+    base_before = np.sort(np.arctan2(p[base, 1], p[base, 0]))
+    wall = [f for f, x in enumerate(s.solid.Faces()) if x.geomType() == "CYLINDER"]
+    reports = lattice_cylinder_faces(s.solid, bag, h, float(np.linalg.norm([0.6, 0.6, 1.1])))
+    assert [x["face"] for x in reports] == wall and reports[0]["kind"] == "cylinder lattice"
+    q = bag.points
+    on = np.isclose(np.hypot(q[:, 0], q[:, 1]), 0.3, atol=1e-9)
+
+    def angles(z):
+        at = on & np.isclose(q[:, 2], z, atol=1e-9)
+        return np.sort(np.arctan2(q[at, 1], q[at, 0]))
+
+    np.testing.assert_allclose(angles(0.0), base_before, atol=1e-12)  # the base's rim stays
+    np.testing.assert_allclose(angles(0.6), base_before, atol=1e-12)  # the cone's takes it
+    rows = np.unique(np.round(q[on & (q[:, 2] > 1e-6) & (q[:, 2] < 0.6 - 1e-6), 2], 9))
+    assert rows.size == reports[0]["rows"] == round(0.6 / h) - 1
+    for z in rows:
+        np.testing.assert_allclose(angles(z), base_before, atol=1e-12)
+    # the cone's rim samples stay on the cone's edge, as feature samples
+    top = on & np.isclose(q[:, 2], 0.6, atol=1e-9)
+    assert bag.on_feature[top].all() and (bag.line_id[top] == -1).all()
+
+
+@pytest.mark.slow
+def test_a_pencils_wall_meets_condition_iii():
+    """The pencil sampled whole: no wall sample breaks III-ii by the geodesic
+    check (its worst was 1.0 with the wall's scan rows)."""
+    pytest.importorskip("potpourri3d")
+    from sr33.validators.conditions import sample_conditions
+
+    s = _pencil()
+    r = scan(s, target_points=1500, quiet=True)
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    wall = [f for f, x in enumerate(s.solid.Faces()) if x.geomType() == "CYLINDER"][0]
+    assert float(rep.worst_ratio[r.face_id == wall].max()) < np.sqrt(3) / 2
