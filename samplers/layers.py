@@ -780,6 +780,9 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
         a_lo, a_hi = np.sort(ang[rim_lo]), np.sort(ang[rim_hi])
         if min(a_lo.size, a_hi.size) < 3:
             continue
+        drop = idx[~(rim_lo | rim_hi)]
+        rim3 = np.empty((0, 3))
+        owner = -1
         if a_lo.size != a_hi.size or np.abs(a_lo - a_hi).max() > 1e-9:
             # a rim whose other face is laid out later (a cone, a chamfer on
             # the cylinder's end) takes the other rim's angles; two rims on
@@ -787,41 +790,23 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
             keep = _rim_to_keep(adjacency, fi, face, o, ez, vmin, vmax, tol)
             if keep is None:
                 continue
-            moved, a_keep = (rim_hi, a_lo) if keep == "lo" else (rim_lo, a_hi)
+            moved, a_lo = (rim_hi, a_lo) if keep == "lo" else (rim_lo, a_hi)
             at = vmax if keep == "lo" else vmin
-            rim3 = (
-                o + at * ez + radius * (np.cos(a_keep)[:, None] * ex + np.sin(a_keep)[:, None] * ey)
-            )
-            owner = int(s.face_id[idx[moved][0]])
-            s.replace(
-                idx[moved],
-                rim3,
-                np.full(a_keep.size, -1),
-                np.full(a_keep.size, owner),
-                np.ones(a_keep.size, dtype=bool),
-            )
-            # the new rim samples are appended: the face's samples anew
-            q = s.points - o
-            axial = dot(q, ez)
-            radial = np.linalg.norm(q - axial[:, None] * ez, axis=1)
-            idx = np.flatnonzero(
-                (np.abs(radial - radius) < tol) & (axial > vmin - tol) & (axial < vmax + tol)
-            )
-            rim_lo = np.abs(axial[idx] - vmin) < tol
-            rim_hi = np.abs(axial[idx] - vmax) < tol
-            a_lo = a_keep
+            rim3 = o + at * ez + radius * (np.cos(a_lo)[:, None] * ex + np.sin(a_lo)[:, None] * ey)
+            owner = int(s.face_id[idx[moved][0]])  # the edge's first face, as in the scan
+            drop = np.r_[drop, idx[moved]]
         rows = steps(vmax - vmin, h)
         z = vmin + (vmax - vmin) * np.arange(1, rows) / rows
         zz = np.repeat(z, a_lo.size)
         aa = np.tile(a_lo, z.size)
         pts3 = o + zz[:, None] * ez + radius * (np.cos(aa)[:, None] * ex + np.sin(aa)[:, None] * ey)
-        drop = idx[~(rim_lo | rim_hi)]
+        n_rim = rim3.shape[0]
         s.replace(
             drop,
-            pts3,
-            line + np.repeat(np.arange(z.size), a_lo.size),
-            np.full(zz.size, fi),
-            np.zeros(zz.size, dtype=bool),
+            np.vstack([rim3, pts3]),
+            np.r_[np.full(n_rim, -1), line + np.repeat(np.arange(z.size), a_lo.size)],
+            np.r_[np.full(n_rim, owner), np.full(zz.size, fi)],
+            np.r_[np.ones(n_rim, dtype=bool), np.zeros(zz.size, dtype=bool)],
         )
         line += z.size
         reports.append(

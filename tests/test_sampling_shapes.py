@@ -1076,7 +1076,8 @@ def test_a_cylinders_rim_on_a_cone_takes_its_other_rims_angles():
     bag = Samples(p, r.line_id, r.face_id, r.on_feature)
     base_before = np.sort(np.arctan2(p[base, 1], p[base, 0]))
     wall = [f for f, x in enumerate(s.solid.Faces()) if x.geomType() == "CYLINDER"]
-    reports = lattice_cylinder_faces(s.solid, bag, h, float(np.linalg.norm([0.6, 0.6, 1.1])))
+    size = float(np.linalg.norm(np.ptp(s.truth_vertices, axis=0)))
+    reports = lattice_cylinder_faces(s.solid, bag, h, size)
     assert [x["face"] for x in reports] == wall and reports[0]["kind"] == "cylinder lattice"
     q = bag.points
     on = np.isclose(np.hypot(q[:, 0], q[:, 1]), 0.3, atol=1e-9)
