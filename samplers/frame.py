@@ -42,8 +42,9 @@ and builds a frame from them:
   axial face (a sphere, a B-spline body) has no frame of its own.
 
 The frame's choice depends on areas, lengths and directions only (no float's
-last bit decides between frames: directions within ``TOL`` are one, weights
-and lengths are compared with a relative margin of 1e-9).
+last bit decides between frames: directions within ``TOL`` are one, and the
+candidates' areas and lengths, as shares of the model's area and size, are
+equal within ``_WEIGHT_TIE``).
 """
 
 from __future__ import annotations
@@ -59,7 +60,7 @@ from .symmetry import mirror_normals, respected
 
 TOL = 1e-7  # directions whose cross product is shorter than this are parallel
 SWITCH = 0.25  # share of the area the model's frame must line up beyond the world's
-_WEIGHT_TIE = 1e-9  # relative difference below which two weights are equal
+_WEIGHT_TIE = 1e-9  # weights (or shares) closer than this, relatively, are equal
 
 WORLD = np.eye(3)
 
@@ -297,11 +298,11 @@ def model_frame(solid) -> Frame:
         # more mirrors kept; more area lined up; more length of straight
         # edges lined up; the longest along x: the same for the frame turned
         # half about z (x and y reversed, its bounds the mirror of these)
-        along = np.abs(line_dirs @ axes.T).max(axis=1) >= 1.0 - TOL if len(line_len) else []
+        along = np.abs(line_dirs @ axes.T).max(axis=1) >= 1.0 - TOL
         head = (
             respected(axes, mirrors),
             _aligned(axes, groups) / total,
-            float(line_len[along].sum()) / size if len(line_len) else 0.0,
+            float(line_len[along].sum()) / size,
             float(hi[0] - lo[0]) / size,
         )
         # then the model reaching farther along +y, then +x, from its centre

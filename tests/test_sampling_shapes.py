@@ -1047,12 +1047,15 @@ def test_a_frustums_samples_stay_on_its_surface():
 
 def _pencil():
     """A cylinder (radius 0.3, height 0.6) under a cone 0.5 high: the
-    cylinder's top rim is the cone's, its bottom rim the base disk's."""
+    cylinder's top rim is the cone's, its bottom rim the base disk's.
+    Returns the shape and its wall's face index."""
     import cadquery as cq
 
     cyl = cq.Solid.makeCylinder(0.3, 0.6)
     cone = cq.Solid.makeCone(0.3, 0.0, 0.5, pnt=cq.Vector(0, 0, 0.6))
-    return shapes.from_cad(cq.Solid(cyl.fuse(cone).clean().Solids()[0].wrapped), name="pencil")
+    s = shapes.from_cad(cq.Solid(cyl.fuse(cone).clean().Solids()[0].wrapped), name="pencil")
+    (wall,) = [f for f, x in enumerate(s.solid.Faces()) if x.geomType() == "CYLINDER"]
+    return s, wall
 
 
 def test_a_cylinders_rim_on_a_cone_takes_its_other_rims_angles():
@@ -1064,7 +1067,7 @@ def test_a_cylinders_rim_on_a_cone_takes_its_other_rims_angles():
     from sr33.samplers.layers import lattice_cylinder_faces
     from sr33.samplers.samples import Samples
 
-    s = _pencil()
+    s, wall = _pencil()
     r = scan(s, target_points=1500, repair=False, quiet=True)
     h = r.meta["spacing"]
     p = r.points.copy()
@@ -1075,10 +1078,9 @@ def test_a_cylinders_rim_on_a_cone_takes_its_other_rims_angles():
     p[base, :2] = p[base, :2] @ np.array([[c, sn], [-sn, c]])
     bag = Samples(p, r.line_id, r.face_id, r.on_feature)
     base_before = np.sort(np.arctan2(p[base, 1], p[base, 0]))
-    wall = [f for f, x in enumerate(s.solid.Faces()) if x.geomType() == "CYLINDER"]
     size = float(np.linalg.norm(np.ptp(s.truth_vertices, axis=0)))
     reports = lattice_cylinder_faces(s.solid, bag, h, size)
-    assert [x["face"] for x in reports] == wall and reports[0]["kind"] == "cylinder lattice"
+    assert [x["face"] for x in reports] == [wall] and reports[0]["kind"] == "cylinder lattice"
     q = bag.points
     on = np.isclose(np.hypot(q[:, 0], q[:, 1]), 0.3, atol=1e-9)
 
@@ -1104,8 +1106,7 @@ def test_a_pencils_wall_meets_condition_iii():
     pytest.importorskip("potpourri3d")
     from sr33.validators.conditions import sample_conditions
 
-    s = _pencil()
+    s, wall = _pencil()
     r = scan(s, target_points=1500, quiet=True)
     rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
-    wall = [f for f, x in enumerate(s.solid.Faces()) if x.geomType() == "CYLINDER"][0]
     assert float(rep.worst_ratio[r.face_id == wall].max()) < np.sqrt(3) / 2
