@@ -45,7 +45,7 @@ from sr33.mesh import dot, flipped_triangles, near_cocircular, norm, triangle_ra
 
 from .adjacency import EdgeFaces
 from .chart import halving_count, radial_clamp
-from .faces import cap_rim, goes_round, perpendicular, steps
+from .faces import cap_rim, goes_round, linked_across, linked_radius, perpendicular, steps
 from .repair import MOVABLE, repair
 from .samples import Samples
 
@@ -138,8 +138,9 @@ def round_faces(adjacency: EdgeFaces, tol: float) -> list[RoundFace]:
     qualifies when across each circle lies nothing (an open rim), a full
     cone or a spherical cap (their rings start from the rim,
     :func:`sr33.samplers.layers.lattice_sphere_caps`), or a full cylinder whose other rim
-    also bounds a qualifying face (so that both rims carry the same
-    columns, :func:`sr33.samplers.layers.lattice_cylinder_faces`).
+    also bounds a qualifying face, directly or through a chamfer's cone band
+    (:func:`sr33.samplers.faces.linked_across`), so that both rims carry
+    the same columns (:func:`sr33.samplers.layers.lattice_cylinder_faces`).
     """
     faces = adjacency.faces
     found = {fi: r for fi, f in enumerate(faces) if (r := _as_round(fi, f, tol)) is not None}
@@ -167,12 +168,23 @@ def _rim_ok(fi: int, edge, adjacency: EdgeFaces, found, tol: float) -> bool:
     for e in face.Edges():
         if e.geomType() == "CIRCLE" and not e.isSame(edge):
             k = adjacency.other(e, other)
+            if k in found and k != fi:
+                return True
+            # a chamfer's cone band on to a qualifying disk: one chain of rims
+            band = linked_across(adjacency, other, e)
+            if band is None or adjacency.faces[band[0]].geomType() != "CONE":
+                return False
+            k = adjacency.other(band[1], band[0])
             return k in found and k != fi
     return False
 
 
 def ring_plan(
-    radii: tuple[float, ...], h: float, gap: float = HALVE_GAP, extra: int = 0
+    radii: tuple[float, ...],
+    h: float,
+    gap: float = HALVE_GAP,
+    extra: int = 0,
+    count: int | None = None,
 ) -> tuple[float, list[tuple[float, int]]]:
     """Radial step and (radius, column count) of every ring, the rims included.
 
@@ -187,6 +199,11 @@ def ring_plan(
         this (times t).
     extra : int
         Rings added to the ``round(W / h)`` steps (a finer radial step).
+    count : int, optional
+        A disk's rim count, of the form ``c 2^k`` (:func:`halving_count`),
+        instead of its own ``halving_count(2 pi r / h)``: the count of a
+        chain of rims it shares (:func:`sr33.samplers.faces.linked_radius`).
+        An annulus' counts start from its inner rim and ignore it.
 
     Returns
     -------
@@ -218,7 +235,7 @@ def ring_plan(
         top = max(0, math.floor(math.log2(2 * math.pi * outer / (gap * t * base))))
         count = rows + 1
     else:
-        n = halving_count(2 * math.pi * outer / h)
+        n = count if count is not None else halving_count(2 * math.pi * outer / h)
         top = 0
         while n > 5 and n % 2 == 0:
             n //= 2
@@ -270,7 +287,7 @@ class _Layout:
     settled: int = 0  # moves of _settle_cocircular
 
 
-def _layout(radii: tuple[float, ...], h: float) -> _Layout:
+def _layout(radii: tuple[float, ...], h: float, count: int | None = None) -> _Layout:
     """The repaired ring samples of a face of these radii: the first ring
     plan (``HALVE_GAPS`` in turn, then the same with one ring more; a plan
     equal to one tried before is skipped) whose layout's worst Delaunay
@@ -284,12 +301,12 @@ def _layout(radii: tuple[float, ...], h: float) -> _Layout:
     tried = set()
     for extra in RINGS_ADDED:
         for gap in HALVE_GAPS:
-            t, rings = ring_plan(radii, h, gap, extra)
+            t, rings = ring_plan(radii, h, gap, extra, count)
             plan = (round(t, 12), tuple(c for _, c in rings))
             if plan in tried:
                 continue
             tried.add(plan)
-            lay = _layout_with(radii, h, gap, extra)
+            lay = _layout_with(radii, h, gap, extra, count)
             rank = (round(lay.worst, 9), round(lay.either, 9))
             if best is None or rank < best[0]:
                 best = (rank, lay)
@@ -298,12 +315,14 @@ def _layout(radii: tuple[float, ...], h: float) -> _Layout:
     return best[1]
 
 
-def _layout_with(radii: tuple[float, ...], h: float, gap: float, extra: int = 0) -> _Layout:
-    """:func:`_layout` for one ring plan (:func:`ring_plan`'s ``gap`` and
-    ``extra``); ``worst`` is that of the face's whole Delaunay triangulation
+def _layout_with(
+    radii: tuple[float, ...], h: float, gap: float, extra: int = 0, count: int | None = None
+) -> _Layout:
+    """:func:`_layout` for one ring plan (:func:`ring_plan`'s ``gap``,
+    ``extra`` and ``count``); ``worst`` is that of the face's whole Delaunay triangulation
     (an annulus' hole left out), ``either`` that with near-cocircular cells
     judged with either diagonal (``COCIRCULAR``)."""
-    t, rings = ring_plan(radii, h, gap, extra)
+    t, rings = ring_plan(radii, h, gap, extra, count)
     disk = len(radii) == 1
     uv, ring, near = _ring_points(t, rings, disk)
     rim = (ring == 0) | ((ring == len(rings) - 1) & (not disk))
@@ -432,9 +451,16 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
         # at 0.872 where the upright's ended at 0.82); the rims are then put
         # back on their circles
         key = tuple(round(r / h, 9) for r in rf.radii)
-        if key not in cache:
-            cache[key] = _layout(key, 1.0)
-        lay = cache[key]
+        count = None
+        if len(key) == 1:
+            # a disk's rim takes the count of the widest circle chained to it
+            # (a chamfer's cone band and the wall beyond carry its columns on)
+            chain = round(linked_radius(adjacency, rf.index, rf.edges[0]) / h, 9)
+            if chain > key[0]:
+                count = halving_count(2 * math.pi * chain)
+        if (key, count) not in cache:
+            cache[key, count] = _layout(key, 1.0, count)
+        lay = cache[key, count]
         uv, rim, ring = lay.uv * h, lay.rim, lay.ring
         radius = np.where(ring == 0, rf.radii[0], rf.radii[-1])[rim]  # outer rim, inner rim
         uv[rim] *= (radius / np.linalg.norm(uv[rim], axis=1))[:, None]

@@ -165,6 +165,66 @@ def whole_band(face) -> bool:
     return True
 
 
+#: a band of revolution links the circles on its two sides into one column
+#: count (:func:`linked_across`) when its smaller circle's radius is at least
+#: this share of the larger one's: with the larger circle's count, the
+#: smaller one's gaps stay within 20 % of the larger one's
+LINK_RATIO = 0.8
+
+
+def _other_circle(face, edge):
+    """The closed circle edge of ``face`` other than ``edge`` (its seam and a
+    degenerate apex aside), or None."""
+    for e in face.Edges():
+        if e.geomType() == "CIRCLE" and e.IsClosed() and not e.isSame(edge):
+            return e
+    return None
+
+
+def linked_across(adjacency, fi: int, edge):
+    """The band across a circle edge of face ``fi`` that carries that
+    circle's columns on to another circle: (the band's index, its other
+    circle edge), or None.
+
+    A band is a full cylinder, or a full cone between two whole circles
+    (:func:`whole_band`) whose smaller radius is at least ``LINK_RATIO`` of
+    its larger one: a chamfer's cone between a cylinder's rim and the disk
+    it bevels.  Samples at the same angles on both circles make the band's
+    cells rectangles however narrow the band is; two column counts make a
+    band narrower than a row a strip of needle triangles (a cylinder of
+    radius 0.33 chamfered by 0.05, its cone band's inner rim laid by the
+    disk and its outer one by the wall: III-ii ratios 0.93 to 1.0).
+    """
+    other = adjacency.other(edge, fi)
+    if other < 0 or edge.geomType() != "CIRCLE":
+        return None
+    face = adjacency.faces[other]
+    if face.geomType() not in ("CYLINDER", "CONE") or not whole_band(face):
+        return None
+    far = _other_circle(face, edge)
+    if far is None:
+        return None
+    small, large = sorted((float(edge.radius()), float(far.radius())))
+    if small < (LINK_RATIO - 1e-9) * large:
+        return None
+    return other, far
+
+
+def linked_radius(adjacency, fi: int, edge) -> float:
+    """The largest radius of the circles linked to ``edge`` (a circle edge
+    of face ``fi``) through bands (:func:`linked_across`), one after
+    another, ``edge``'s own included: the circle whose column count the
+    chain shares (a chamfered cylinder's two disks, of radii r and r - c,
+    both take the count of r, the wall's)."""
+    radius = float(edge.radius())
+    seen = {fi}
+    while (step := linked_across(adjacency, fi, edge)) is not None and step[0] not in seen:
+        fi, edge = step
+        seen.add(fi)
+        radius = max(radius, float(edge.radius()))
+    return radius
+
+
 def revolution_axis(face):
     """(point, unit direction) of a cone's, cylinder's, sphere's or torus's
     axis (a sphere's and a torus's point is its centre)."""

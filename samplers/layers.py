@@ -46,6 +46,7 @@ from .faces import (
     boundary_segments,
     cap_rim,
     goes_round,
+    linked_across,
     perpendicular,
     revolution_axis,
     row_cosine,
@@ -718,11 +719,14 @@ def _full_turns(occ, kind: str):
             yield fi, face
 
 
-def _rim_to_keep(adjacency, fi: int, face, o, ez, vmin: float, vmax: float, tol: float):
-    """Which rim of a full cylinder keeps its samples when the two differ:
-    "lo" or "hi" when the other rim's face across is not a plane (laid out
-    after the cylinders, from the rim it is given), the lower one when
-    neither is; None when both are planes (repaired already)."""
+def _rim_sources(adjacency, fi: int, face, o, ez, vmin: float, vmax: float, tol: float):
+    """What lies across each rim of a full cylinder: per side ("lo" at
+    ``vmin``, "hi" at ``vmax``, along ``ez`` from ``o``), ``("plane",
+    None)`` for a planar face (repaired or laid out already: its rim stays),
+    ``("band", edge)`` for a cone band that carries the rim's columns on to
+    its other circle ``edge`` (:func:`sr33.samplers.faces.linked_across`: a
+    chamfer), ``("other", None)`` for anything else; a rim with nothing
+    across (an open end) is left out."""
     across = {}
     for e in face.Edges():
         k = adjacency.index(e)
@@ -731,12 +735,20 @@ def _rim_to_keep(adjacency, fi: int, face, o, ez, vmin: float, vmax: float, tol:
         at = float(dot(np.array(e.Center().toTuple()) - o, ez))
         side = "lo" if abs(at - vmin) < tol else "hi" if abs(at - vmax) < tol else None
         other = adjacency.other(e, fi)
-        if side is not None and other >= 0:
-            across[side] = adjacency.faces[other].geomType()
-    planes = {side for side, kind in across.items() if kind == "PLANE"}
-    if planes == {"lo", "hi"} or len(across) < 2:
-        return None
-    return "hi" if planes == {"hi"} else "lo"
+        if side is None or other < 0:
+            continue
+        band = linked_across(adjacency, fi, e)
+        if adjacency.faces[other].geomType() == "PLANE":
+            across[side] = ("plane", None)
+        elif band is not None and adjacency.faces[band[0]].geomType() == "CONE":
+            across[side] = ("band", band[1])
+        else:
+            across[side] = ("other", None)
+    return across
+
+
+def _same_angles(a: np.ndarray, b: np.ndarray) -> bool:
+    return a.size == b.size and bool(np.abs(a - b).max() <= 1e-9)
 
 
 def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
@@ -744,15 +756,19 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
 
     The scan rows of a cylinder are circles; sampled by arc length from the
     seam they line up with the rims' samples only when their count happens
-    to match.  Here each cylinder whose two rims carry the same angles gets
-    ``round(H / h) - 1`` rows evenly between them (the sections by planes
-    spaced ``H / round(H / h)`` along the axis), each with the rims' angles:
-    a rectangular lattice on the unrolled cylinder.  Where the rims differ
-    (a planar face's repair slid one) and the face across the other rim is
-    laid out after the cylinders (a cone, from the rim it is given), that
-    rim takes the first one's angles (:func:`_rim_to_keep`): a pencil's
-    wall, between its base and its cone, kept its scan rows before, and 58
-    of 2,968 samples broke III-ii there (0 now, worst 0.83 at 3,000).
+    to match.  Here each cylinder gets ``round(H / h) - 1`` rows evenly
+    between its rims (the sections by planes spaced ``H / round(H / h)``
+    along the axis), each with one set of angles, the rims' too: a
+    rectangular lattice on the unrolled cylinder.  The angles are those of
+    the first of: a rim on a planar face (repaired or laid out already, it
+    stays; two such rims that differ leave the cylinder to its scan rows),
+    the far circle of a chamfer's cone band across a rim (so that the band,
+    narrower than a row, has its columns on both circles: a chamfered
+    cylinder's disk laid in rings, :func:`sr33.samplers.disks.lattice_disk_faces`),
+    the rims themselves where they agree, the lower rim where both have a
+    face across.  A rim that differs takes them: a pencil's wall, between
+    its base and its cone, kept its scan rows before, and 58 of 2,968
+    samples broke III-ii there (0 now, worst 0.83 at 3,000).
     """
     reports = []
     tol = 1e-7 * size
@@ -770,47 +786,76 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
         q = s.points - o
         axial = dot(q, ez)
         radial = np.linalg.norm(q - axial[:, None] * ez, axis=1)
+
+        def angles(sel, q=q, ex=ex, ey=ey):
+            """The angles about the axis of the samples ``sel``, ascending."""
+            return np.sort(np.arctan2(dot(q[sel], ey), dot(q[sel], ex)) % (2 * math.pi))
+
         mine = (np.abs(radial - radius) < tol) & (axial > vmin - tol) & (axial < vmax + tol)
         idx = np.flatnonzero(mine)
-        ang = np.arctan2(dot(q[idx], ey), dot(q[idx], ex)) % (2 * math.pi)
         # the rims' samples by position (a planar face's repair may have
         # added one on a rim: it is on the sharp edge all the same)
-        rim_lo = np.abs(axial[idx] - vmin) < tol
-        rim_hi = np.abs(axial[idx] - vmax) < tol
-        a_lo, a_hi = np.sort(ang[rim_lo]), np.sort(ang[rim_hi])
-        if min(a_lo.size, a_hi.size) < 3:
+        rims = {"lo": np.abs(axial[idx] - vmin) < tol, "hi": np.abs(axial[idx] - vmax) < tol}
+        own = {side: angles(idx[on]) for side, on in rims.items()}
+        if min(a.size for a in own.values()) < 3:
             continue
-        drop = idx[~(rim_lo | rim_hi)]
-        rim3 = np.empty((0, 3))
-        owner = -1
-        if a_lo.size != a_hi.size or np.abs(a_lo - a_hi).max() > 1e-9:
-            # a rim whose other face is laid out later (a cone, a chamfer on
-            # the cylinder's end) takes the other rim's angles; two rims on
-            # faces repaired already stay as they are
-            keep = _rim_to_keep(adjacency, fi, face, o, ez, vmin, vmax, tol)
-            if keep is None:
-                continue
-            moved, a_lo = (rim_hi, a_lo) if keep == "lo" else (rim_lo, a_hi)
-            at = vmax if keep == "lo" else vmin
-            rim3 = o + at * ez + radius * (np.cos(a_lo)[:, None] * ex + np.sin(a_lo)[:, None] * ey)
-            owner = int(s.face_id[idx[moved][0]])  # the edge's first face, as in the scan
-            drop = np.r_[drop, idx[moved]]
+        sources = _rim_sources(adjacency, fi, face, o, ez, vmin, vmax, tol)
+        if not _same_angles(own["lo"], own["hi"]) and len(sources) < 2:
+            continue  # an open end: the rims stay as the scan left them
+        given = []  # (fixed, angles): the planes' rims first, then the bands' far circles
+        for side in ("lo", "hi"):
+            kind, far = sources.get(side, (None, None))
+            if kind == "plane":
+                given.append((0, own[side]))
+            elif kind == "band":
+                at = float(dot(np.array(far.Center().toTuple()) - o, ez))
+                on = (
+                    s.on_feature
+                    & (np.abs(axial - at) < tol)
+                    & (np.abs(radial - float(far.radius())) < tol)
+                )
+                if on.sum() >= 3:
+                    given.append((1, angles(on)))
+        given.sort(key=lambda g: g[0])
+        target = given[0][1] if given else own["lo"]
+        moved = [side for side in ("lo", "hi") if not _same_angles(own[side], target)]
+        if not moved:
+            target = own["lo"]
+        if any(sources.get(side, ("",))[0] == "plane" for side in moved):
+            continue  # a plane's rim cannot move: two such rims differ
+        drop = [idx[~(rims["lo"] | rims["hi"])]]
+        rim3 = [np.empty((0, 3))]
+        owners = []
+        for side in moved:
+            at = vmin if side == "lo" else vmax
+            rim3.append(
+                o + at * ez + radius * (np.cos(target)[:, None] * ex + np.sin(target)[:, None] * ey)
+            )
+            # the edge's first face, as in the scan
+            owners.append(np.full(target.size, int(s.face_id[idx[rims[side]][0]])))
+            drop.append(idx[rims[side]])
+        rim3 = np.vstack(rim3)
         rows = steps(vmax - vmin, h)
         z = vmin + (vmax - vmin) * np.arange(1, rows) / rows
-        zz = np.repeat(z, a_lo.size)
-        aa = np.tile(a_lo, z.size)
+        zz = np.repeat(z, target.size)
+        aa = np.tile(target, z.size)
         pts3 = o + zz[:, None] * ez + radius * (np.cos(aa)[:, None] * ex + np.sin(aa)[:, None] * ey)
         n_rim = rim3.shape[0]
         s.replace(
-            drop,
+            np.concatenate(drop),
             np.vstack([rim3, pts3]),
-            np.r_[np.full(n_rim, -1), line + np.repeat(np.arange(z.size), a_lo.size)],
-            np.r_[np.full(n_rim, owner), np.full(zz.size, fi)],
+            np.r_[np.full(n_rim, -1), line + np.repeat(np.arange(z.size), target.size)],
+            np.r_[np.concatenate(owners or [np.empty(0, np.int64)]), np.full(zz.size, fi)],
             np.r_[np.ones(n_rim, dtype=bool), np.zeros(zz.size, dtype=bool)],
         )
         line += z.size
         reports.append(
-            {"face": fi, "kind": "cylinder lattice", "rows": int(z.size), "columns": int(a_lo.size)}
+            {
+                "face": fi,
+                "kind": "cylinder lattice",
+                "rows": int(z.size),
+                "columns": int(target.size),
+            }
         )
     return reports
 

@@ -460,6 +460,28 @@ def test_revolved_body_is_laid_out_in_rings():
     assert d.max() < 2e-3 * r.meta["spacing"] * 50  # on the surface, up to the truth's sagitta
 
 
+@pytest.mark.parametrize("radius, chained", [(0.28, 0.33), (0.45, 0.5), (0.4, 0.5)])
+def test_ring_plan_gives_a_disks_rim_the_count_of_its_chain(radius, chained):
+    """A disk chained to a wider circle (a chamfered cylinder's top, r - c,
+    to its wall, r) takes that circle's count on its rim; inside, its rings
+    halve as their own gaps ask, one base count throughout."""
+    from sr33.samplers.chart import halving_count
+    from sr33.samplers.disks import ring_plan
+
+    h = 0.025
+    count = halving_count(2 * np.pi * chained / h)
+    t, rings = ring_plan((radius,), h, count=count)
+    own_t, own = ring_plan((radius,), h)
+    assert t == own_t and len(rings) == len(own)
+    r = np.array([x for x, _ in rings])
+    c = np.array([n for _, n in rings])
+    assert c[0] == count
+    assert np.all((c[:-2] == c[1:-1]) | (c[:-2] == 2 * c[1:-1]))
+    assert 3 <= c[-1] <= 5 and all(n % c[-1] == 0 for n in c)
+    gaps = 2 * np.pi * r[1:-1] / c[1:-1]
+    assert gaps.min() >= 0.75 * t - 1e-12 and gaps.max() < 1.5 * t
+
+
 @pytest.mark.parametrize("gap", [0.75, 0.7, 0.8])
 @pytest.mark.parametrize(
     "radii, h", [((0.5,), 0.025), ((0.5,), 0.03), ((0.5, 0.3), 0.02), ((0.35, 0.05), 0.02)]
@@ -507,7 +529,7 @@ def test_a_disk_layout_tries_other_ring_plans_until_one_meets_the_margin(monkeyp
     def fake(worst_of):
         seen = []
 
-        def layout_with(radii, h, gap, extra=0):
+        def layout_with(radii, h, gap, extra=0, count=None):
             seen.append((extra, gap))
             w = worst_of(len(seen) - 1)
             return disks._Layout(
@@ -1110,3 +1132,90 @@ def test_a_pencils_wall_meets_condition_iii():
     r = scan(s, target_points=1500, quiet=True)
     rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
     assert float(rep.worst_ratio[r.face_id == wall].max()) < np.sqrt(3) / 2
+
+
+def _chamfered_cylinder(both: bool = False):
+    """A cylinder of radius 0.33 and height 0.5 whose top edge (or both
+    edges) is chamfered by 0.05: a cone band about 0.07 wide, narrower than
+    a row at 1,500 samples (h about 0.04)."""
+    import cadquery as cq
+
+    w = cq.Workplane().circle(0.33).extrude(0.5)
+    solid = (w.edges() if both else w.faces(">Z").edges()).chamfer(0.05).val()
+    return shapes.from_cad(solid, name="chamfered cylinder")
+
+
+def test_a_chamfers_cone_band_chains_its_disk_to_the_wall():
+    """Both disks of a cylinder chamfered on top qualify for rings: the
+    base through the wall and the chamfer's cone band on to the top disk
+    (before, only the top disk did, and the base's repair slid its rim to a
+    count of its own).  Both take the count of the widest circle chained to
+    them, the wall's; a cone band whose circles are far apart in radius
+    (a frustum from 0.5 to 0.2) chains nothing."""
+    import cadquery as cq
+
+    from sr33.samplers.adjacency import EdgeFaces
+    from sr33.samplers.disks import round_faces
+    from sr33.samplers.faces import linked_across, linked_radius
+
+    s = _chamfered_cylinder()
+    adj = EdgeFaces(s.solid)
+    found = round_faces(adj, 1e-9)
+    assert [rf.index for rf in found] == [
+        f for f, x in enumerate(s.solid.Faces()) if x.geomType() == "PLANE"
+    ]
+    assert sorted(round(rf.radii[0], 9) for rf in found) == [0.28, 0.33]
+    for rf in found:
+        assert linked_radius(adj, rf.index, rf.edges[0]) == pytest.approx(0.33, abs=1e-12)
+    frustum = shapes.from_cad(cq.Solid.makeCone(0.5, 0.2, 0.3), name="frustum")
+    adj = EdgeFaces(frustum.solid)
+    for rf in round_faces(adj, 1e-9):
+        assert linked_across(adj, rf.index, rf.edges[0]) is None
+        assert linked_radius(adj, rf.index, rf.edges[0]) == pytest.approx(rf.radii[0])
+
+
+@pytest.mark.parametrize("both", [False, True], ids=["top", "both ends"])
+def test_a_chamfered_cylinders_circles_carry_one_set_of_columns(both):
+    """Every circle of a chamfered cylinder (the disks' rims, the wall's
+    rims and rows, the cone bands') carries the same angles, as many as
+    the wall's circle asks (``halving_count(2 pi r / h)``): the chamfer's
+    band, narrower than a row, is a strip of rectangles.  Before, its
+    inner circle had the top disk's own count and its outer one the
+    count the base's repair left, and 38 of 1,455 samples broke III-ii
+    (0.999)."""
+    from sr33.samplers.chart import halving_count
+
+    s = _chamfered_cylinder(both)
+    r = scan(s, target_points=1500, quiet=True)
+    h = r.meta["spacing"]
+    p = r.points
+    radial = np.hypot(p[:, 0], p[:, 1])
+    ang = np.arctan2(p[:, 1], p[:, 0]) % (2 * np.pi)
+    wall = np.isclose(radial, 0.33, atol=1e-9) & (p[:, 2] > 0.05 - 1e-9 if both else True)
+    wall &= p[:, 2] < 0.45 + 1e-9
+    columns = np.sort(ang[wall & np.isclose(p[:, 2], 0.45, atol=1e-9)])
+    assert columns.size == halving_count(2 * np.pi * 0.33 / h)
+    circles = [(0.5, 0.28)] + ([(0.0, 0.28), (0.05, 0.33)] if both else [(0.0, 0.33)])
+    for z, rad in circles:
+        at = np.isclose(p[:, 2], z, atol=1e-9) & np.isclose(radial, rad, atol=1e-9)
+        assert r.on_feature[at].all()
+        np.testing.assert_allclose(np.sort(ang[at]), columns, atol=1e-9)
+    rows = np.unique(np.round(p[wall, 2], 9))
+    assert rows.size >= 3
+    for z in rows:
+        at = wall & np.isclose(p[:, 2], z, atol=1e-9)
+        np.testing.assert_allclose(np.sort(ang[at]), columns, atol=1e-9)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("both", [False, True], ids=["top", "both ends"])
+def test_a_chamfered_cylinder_meets_condition_iii_with_the_margin(both):
+    """A chamfered cylinder sampled whole meets III-ii by the geodesic check
+    with the margin of the library's defaults (0.999 before)."""
+    pytest.importorskip("potpourri3d")
+    from sr33.validators.conditions import sample_conditions
+
+    s = _chamfered_cylinder(both)
+    r = scan(s, target_points=1500, quiet=True)
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    assert float(np.nanmax(rep.worst_ratio)) < 0.85
