@@ -453,8 +453,12 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
     1e-9 h grid (a model turned off the axes, whose radii differ in their
     last bits, gets the upright's layout; the rims are then put back on
     their circles), so faces of equal radii get one layout (a cylinder's two
-    caps).  Returns one report per face and the indices of the faces laid
-    out.
+    caps).  A disk's rim takes the count of the widest circle chained to it
+    through cylinders and narrow cone bands
+    (:func:`sr33.samplers.faces.linked_radius`): a chamfered cylinder's top
+    disk, of radius r - c, carries the wall's count, so that the chamfer's
+    band has the same columns on both its circles.  Returns one report per
+    face and the indices of the faces laid out.
     """
     tol = 1e-7 * size
     adjacency = EdgeFaces(occ)
