@@ -748,6 +748,7 @@ def _rim_sources(adjacency, fi: int, face, o, ez, vmin: float, vmax: float, tol:
 
 
 def _same_angles(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two rims' sorted angles are the same, to 1e-9."""
     return a.size == b.size and bool(np.abs(a - b).max() <= 1e-9)
 
 
