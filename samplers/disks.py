@@ -251,21 +251,21 @@ def ring_plan(
     if inner > 0:
         base = steps(2 * math.pi * inner, h, least=3)
         top = max(0, math.floor(math.log2(2 * math.pi * outer / (gap * t * base))))
-        count = rows + 1
+        nrings = rows + 1
     else:
         n = count if count is not None else halving_count(2 * math.pi * outer / h)
         top = 0
         while n > 5 and n % 2 == 0:
             n //= 2
             top += 1
-        base, count = n, rows
+        base, nrings = n, rows
     rings = []
     level = top
-    for j in range(count):
+    for j in range(nrings):
         r = outer - j * t
         fit = math.floor(math.log2(2 * math.pi * r / (gap * t * base)))
         level = max(0, min(level, fit)) if j else top
-        if j == count - 1 and (inner > 0 or j > 0):
+        if j == nrings - 1 and (inner > 0 or j > 0):
             level = 0  # the inner rim, or the ring round a disk's centre
         rings.append((r, base << level))
     return t, rings

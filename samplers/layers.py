@@ -747,6 +747,12 @@ def _rim_sources(adjacency, fi: int, face, o, ez, vmin: float, vmax: float, tol:
     return across
 
 
+def _angles_about(q: np.ndarray, ex: np.ndarray, ey: np.ndarray) -> np.ndarray:
+    """The angles of the offsets ``q`` (from a point on an axis) about the
+    axis, in the frame ``ex``, ``ey`` across it, ascending in [0, 2 pi)."""
+    return np.sort(np.arctan2(dot(q, ey), dot(q, ex)) % (2 * math.pi))
+
+
 def _same_angles(a: np.ndarray, b: np.ndarray) -> bool:
     """Whether two rims' sorted angles are the same, to 1e-9."""
     return a.size == b.size and bool(np.abs(a - b).max() <= 1e-9)
@@ -788,26 +794,23 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
         axial = dot(q, ez)
         radial = np.linalg.norm(q - axial[:, None] * ez, axis=1)
 
-        def angles(sel, q=q, ex=ex, ey=ey):
-            """The angles about the axis of the samples ``sel``, ascending."""
-            return np.sort(np.arctan2(dot(q[sel], ey), dot(q[sel], ex)) % (2 * math.pi))
-
         mine = (np.abs(radial - radius) < tol) & (axial > vmin - tol) & (axial < vmax + tol)
         idx = np.flatnonzero(mine)
         # the rims' samples by position (a planar face's repair may have
         # added one on a rim: it is on the sharp edge all the same)
         rims = {"lo": np.abs(axial[idx] - vmin) < tol, "hi": np.abs(axial[idx] - vmax) < tol}
-        own = {side: angles(idx[on]) for side, on in rims.items()}
+        own = {side: _angles_about(q[idx[on]], ex, ey) for side, on in rims.items()}
         if min(a.size for a in own.values()) < 3:
             continue
         sources = _rim_sources(adjacency, fi, face, o, ez, vmin, vmax, tol)
         if not _same_angles(own["lo"], own["hi"]) and len(sources) < 2:
             continue  # an open end: the rims stay as the scan left them
-        given = []  # (fixed, angles): the planes' rims first, then the bands' far circles
+        # the angles: a plane's rim, else a chamfer band's far circle, else the lower rim
+        planes, bands = [], []
         for side in ("lo", "hi"):
             kind, far = sources.get(side, (None, None))
             if kind == "plane":
-                given.append((0, own[side]))
+                planes.append(own[side])
             elif kind == "band":
                 at = float(dot(np.array(far.Center().toTuple()) - o, ez))
                 on = (
@@ -816,12 +819,11 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
                     & (np.abs(radial - float(far.radius())) < tol)
                 )
                 if on.sum() >= 3:
-                    given.append((1, angles(on)))
-        given.sort(key=lambda g: g[0])
-        target = given[0][1] if given else own["lo"]
+                    bands.append(_angles_about(q[on], ex, ey))
+        target = (planes + bands + [own["lo"]])[0]
         moved = [side for side in ("lo", "hi") if not _same_angles(own[side], target)]
         if not moved:
-            target = own["lo"]
+            target = own["lo"]  # equal to 1e-9: the lower rim's own bits
         if any(sources.get(side, ("",))[0] == "plane" for side in moved):
             continue  # a plane's rim cannot move: two such rims differ
         drop = [idx[~(rims["lo"] | rims["hi"])]]
@@ -1039,10 +1041,6 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         cos_a = math.cos(abs(cone.SemiAngle()))
         q = s.points - apex
 
-        def angles(idx, q=q, ex=ex, ey=ey):
-            """The samples' angles about the axis, ascending in [0, 2 pi)."""
-            return np.sort(np.arctan2(dot(q[idx], ey), dot(q[idx], ex)) % (2 * math.pi))
-
         along = dot(q, axis)
         radial = np.linalg.norm(q - along[:, None] * axis, axis=1)
         on = np.abs(radial - along * tan_a) < tol * 10
@@ -1064,10 +1062,10 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
             low = cand[s.on_feature[cand] & (np.abs(along[cand] - bottom) < tol * 10)]
             if low.size < 3:
                 continue
-            inner = (bottom / cos_a, angles(low))
+            inner = (bottom / cos_a, _angles_about(q[low], ex, ey))
         rows = steps(slant, h)
         t = slant / rows
-        rim_ang = angles(rim)
+        rim_ang = _angles_about(q[rim], ex, ey)
         # rings halving by design from the rim to the apex's last rows (one
         # step apart, ending columns by their gaps, repaired): the first of
         # APEX_REACH rows, then one to two fewer, then more, that no halving
@@ -1852,7 +1850,7 @@ def lattice_sphere_caps(occ, s: Samples, h: float, size: float) -> tuple[list[di
         t = radius * theta / rows
         ex = perpendicular(pole)
         ey = np.cross(pole, ex)
-        rim_ang = np.sort(np.arctan2(dot(q[rim], ey), dot(q[rim], ex)) % (2 * math.pi))
+        rim_ang = _angles_about(q[rim], ex, ey)
         gaps = np.diff(np.r_[rim_ang, rim_ang[0] + 2 * math.pi])
         if rim.size != halving_count(rim.size) or np.ptp(gaps) > 1e-6 * gaps.mean():
             # from the rim's vertex (not the pole's, whose angle is noise)

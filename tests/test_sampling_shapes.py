@@ -1067,6 +1067,24 @@ def test_a_frustums_samples_stay_on_its_surface():
     assert [x["kind"] for x in r.meta["repairs"]].count("cone rings") == 1
 
 
+def _fused(a, b, name: str):
+    """The one solid of CadQuery solids ``a`` and ``b`` fused (coplanar
+    faces merged), as a shape."""
+    import cadquery as cq
+
+    return shapes.from_cad(cq.Solid(a.fuse(b).clean().Solids()[0].wrapped), name=name)
+
+
+def _geodesic_ratios(s, target_points: int):
+    """``s`` scanned at ``target_points``, and each sample's worst III-ii
+    ratio by the geodesic check (skipped without potpourri3d)."""
+    pytest.importorskip("potpourri3d")
+    from sr33.validators.conditions import sample_conditions
+
+    r = scan(s, target_points=target_points, quiet=True)
+    return r, sample_conditions(r.points, s.truth_vertices, s.truth_triangles).worst_ratio
+
+
 def _pencil():
     """A cylinder (radius 0.3, height 0.6) under a cone 0.5 high: the
     cylinder's top rim is the cone's, its bottom rim the base disk's.
@@ -1075,7 +1093,7 @@ def _pencil():
 
     cyl = cq.Solid.makeCylinder(0.3, 0.6)
     cone = cq.Solid.makeCone(0.3, 0.0, 0.5, pnt=cq.Vector(0, 0, 0.6))
-    s = shapes.from_cad(cq.Solid(cyl.fuse(cone).clean().Solids()[0].wrapped), name="pencil")
+    s = _fused(cyl, cone, "pencil")
     (wall,) = [f for f, x in enumerate(s.solid.Faces()) if x.geomType() == "CYLINDER"]
     return s, wall
 
@@ -1125,13 +1143,9 @@ def test_a_cylinders_rim_on_a_cone_takes_its_other_rims_angles():
 def test_a_pencils_wall_meets_condition_iii():
     """The pencil sampled whole: no wall sample breaks III-ii by the geodesic
     check (its worst was 1.0 with the wall's scan rows)."""
-    pytest.importorskip("potpourri3d")
-    from sr33.validators.conditions import sample_conditions
-
     s, wall = _pencil()
-    r = scan(s, target_points=1500, quiet=True)
-    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
-    assert float(rep.worst_ratio[r.face_id == wall].max()) < np.sqrt(3) / 2
+    r, worst = _geodesic_ratios(s, 1500)
+    assert float(worst[r.face_id == wall].max()) < np.sqrt(3) / 2
 
 
 def _chamfered_cylinder(both: bool = False):
@@ -1214,13 +1228,8 @@ def test_a_chamfered_cylinder_meets_condition_iii_with_the_margin(both):
     with the margin of the library's defaults (chamfered on top: 0.999
     before; on both ends it conformed before too, 0.822, its rims' counts
     happening to agree)."""
-    pytest.importorskip("potpourri3d")
-    from sr33.validators.conditions import sample_conditions
-
-    s = _chamfered_cylinder(both)
-    r = scan(s, target_points=1500, quiet=True)
-    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
-    assert float(np.nanmax(rep.worst_ratio)) < 0.85
+    _, worst = _geodesic_ratios(_chamfered_cylinder(both), 1500)
+    assert float(np.nanmax(worst)) < 0.85
 
 
 def _domed_cylinder():
@@ -1231,7 +1240,7 @@ def _domed_cylinder():
     cyl = cq.Solid.makeCylinder(0.3, 0.4)
     sphere = cq.Solid.makeSphere(0.5, pnt=cq.Vector(0, 0, 0.0))
     cap = sphere.intersect(cq.Solid.makeCylinder(0.3, 1.0, pnt=cq.Vector(0, 0, 0.4)))
-    return shapes.from_cad(cq.Solid(cyl.fuse(cap).clean().Solids()[0].wrapped), name="dome")
+    return _fused(cyl, cap, "dome")
 
 
 def test_a_disk_qualifies_when_its_walls_far_rim_is_laid_from_the_rim():
@@ -1252,7 +1261,7 @@ def test_a_disk_qualifies_when_its_walls_far_rim_is_laid_from_the_rim():
         assert [rf.index for rf in round_faces(EdgeFaces(s.solid), 1e-9)] == planes(s)
     post = cq.Solid.makeCylinder(0.2, 0.6, pnt=cq.Vector(0, 0, -0.3))
     plate = cq.Solid.makeBox(1.0, 1.0, 0.1, pnt=cq.Vector(-0.5, -0.5, 0.3))
-    s = shapes.from_cad(cq.Solid(post.fuse(plate).clean().Solids()[0].wrapped), name="post")
+    s = _fused(post, plate, "post")
     assert round_faces(EdgeFaces(s.solid), 1e-9) == []
 
 
@@ -1261,10 +1270,5 @@ def test_a_domed_cylinder_meets_condition_iii_with_the_margin():
     """A cylinder under a spherical cap, sampled whole: its base in rings,
     its wall a lattice, its cap in rings from the rim (0.999 before, 138
     samples at or above 0.85 on the wall and the cap)."""
-    pytest.importorskip("potpourri3d")
-    from sr33.validators.conditions import sample_conditions
-
-    s = _domed_cylinder()
-    r = scan(s, target_points=3000, quiet=True)
-    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
-    assert float(np.nanmax(rep.worst_ratio)) < 0.85
+    _, worst = _geodesic_ratios(_domed_cylinder(), 3000)
+    assert float(np.nanmax(worst)) < 0.85
