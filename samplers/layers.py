@@ -53,7 +53,7 @@ from .faces import (
     steps,
     whole_band,
 )
-from .repair import GAP, MOVABLE, RETRY_BAD, Repaired, copies, repair, split_corners
+from .repair import BAD, GAP, MOVABLE, RETRY_BAD, Repaired, copies, repair, split_corners
 from .rings import HALVING_GAP, ring_positions
 from .samples import Samples
 
@@ -220,6 +220,7 @@ class _Line:
     follows: bool = False  # parallel to them: its samples slide, that face's columns follow
     ends3: np.ndarray | None = None  # (2, 3) the 3-D ends
     other: int = -1  # the neighbouring face's index
+    square: bool = False  # along or across the face's rows (repaired only where staggered)
 
     def along(self, p: np.ndarray) -> np.ndarray:
         """The edge parameter of each point's foot (0 at ``a``, 1 at ``b``)."""
@@ -319,7 +320,9 @@ def _plain_lattice(face, row_dir) -> bool:
     return True
 
 
-def _slanted_lines(occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs) -> list[_Line]:
+def _slanted_lines(
+    occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs, squares: bool = False
+) -> list[_Line]:
     """Sharp straight edges of a planar face, between it and another planar
     face, neither parallel nor perpendicular to the face's scan rows (those
     rows end on them at arbitrary places); with the other face's samples
@@ -336,11 +339,14 @@ def _slanted_lines(occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs) -
     for e, fb in nbrs[fi]:
         if e.geomType() != "LINE" or fb < 0 or faces[fb].geomType() != "PLANE":
             continue
+        if abs(float(dot(n, np.array(faces[fb].normalAt().toTuple())))) > 1 - 1e-9:
+            continue  # a seam between coplanar faces (a union's): no edge, no samples on it
         a3 = np.array(e.startPoint().toTuple())
         b3 = np.array(e.endPoint().toTuple())
         length = float(norm(b3 - a3))
         u = (b3 - a3) / length
-        if not _slanted(face, np.asarray(row_dirs[fi]), u):
+        square = not _slanted(face, np.asarray(row_dirs[fi]), u)
+        if square and not squares:
             continue
         a2, b2 = to2d(np.stack([a3, b3]))
         # the edge's normal in the face's plane, in 3-D and in plane coordinates
@@ -357,15 +363,34 @@ def _slanted_lines(occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs) -
         near = (t > 0) & (t < length) & (dist < LAYER * h)
         unfolded = foot[near] - dist[near, None] * m3
         frame = to2d(unfolded) if near.any() else np.empty((0, 2))
-        slides = _slanted(faces[fb], np.asarray(row_dirs[fb]), u)
+        slides = not square and _slanted(faces[fb], np.asarray(row_dirs[fb]), u)
         follows = (
-            not slides
+            not square
+            and not slides
             and _parallel_rows(faces[fb], np.asarray(row_dirs[fb]), u)
             and _plain_lattice(faces[fb], np.asarray(row_dirs[fb]))
             and _step_fits(s, a3, u, length, h)
         )
-        out.append(_Line(a2, b2, m, frame, slides, follows, np.stack([a3, b3]), fb))
+        out.append(_Line(a2, b2, m, frame, slides, follows, np.stack([a3, b3]), fb, square))
     return out
+
+
+def _staggered(uv: np.ndarray, line: _Line, h: float) -> bool:
+    """Whether the Delaunay triangles of a face's samples within ``LAYER`` h
+    of a straight edge and of the neighbour's samples unfolded across it
+    (``line.frame``) include one at or above the repair's ``BAD``: the
+    face's lattice and the edge's samples stagger there."""
+    near = uv[line.distance(uv) < LAYER * h]
+    pts = np.vstack([near, line.frame])
+    if pts.shape[0] < 3:
+        return False
+    try:
+        tri = Delaunay(pts).simplices
+    except Exception:  # degenerate (collinear) input: nothing to judge
+        return False
+    e = np.linalg.norm(pts[tri] - pts[np.roll(tri, 1, axis=1)], axis=2)
+    tri = tri[e.max(axis=1) < 2.0 * h]  # the hull's long chords are no triangles of the surface
+    return bool(tri.size) and bool((triangle_ratios(pts, tri) >= BAD).any())
 
 
 def _chain(fns):
@@ -426,6 +451,7 @@ def repair_planar_faces(
     skip=frozenset(),
     again: int = AGAIN_ROUNDS,
     walls: dict[int, np.ndarray] | None = None,
+    squares: bool = False,
 ) -> list[dict]:
     """Repair the boundary layer of every planar face bounded by circular arcs
     or by straight sharp edges slanted to its scan rows.
@@ -496,10 +522,12 @@ def repair_planar_faces(
         seg = boundary_segments(face, to2d, h / 20)
         raster = Raster(seg, h / RASTER)
         lines = (
-            _slanted_lines(occ, fi, face, to2d, row_dirs, s, raster, h, nbrs)
+            _slanted_lines(occ, fi, face, to2d, row_dirs, s, raster, h, nbrs, squares=squares)
             if row_dirs is not None
             else []
         )
+        if squares and (arcs or any(not ln.square for ln in lines)):
+            continue  # repaired in the first pass
         if not arcs and not lines:
             continue
         on_plane = np.abs(dot(s.points - o, n)) < tol
@@ -513,6 +541,9 @@ def repair_planar_faces(
         # a fixed order (by position) so that congruent faces get the same answer
         order = np.lexsort((np.round(uv[:, 1] / h, 6), np.round(uv[:, 0] / h, 6)))
         idx, uv = idx[order], uv[order]
+        lines = [ln for ln in lines if not ln.square or _staggered(uv, ln, h)]
+        if not arcs and not lines:
+            continue
         far = np.full(uv.shape[0], np.inf)
         near_arc = np.min(np.stack([far] + [a.distance(uv) for a in arcs], axis=1), axis=1)
         near_line = np.min(np.stack([far] + [ln.distance(uv) for ln in lines], axis=1), axis=1)
@@ -640,7 +671,7 @@ def repair_planar_faces(
         redone = {
             x["face"]: x
             for x in repair_planar_faces(
-                occ, s, h, size, row_dirs, rest, again=again - 1, walls=walls
+                occ, s, h, size, row_dirs, rest, again=again - 1, walls=walls, squares=squares
             )
         }
         reports = [redone.get(x["face"], x) for x in reports]

@@ -93,6 +93,10 @@ EDGE_STEP = 1.0  # spacing of corner/edge samples, times h
 FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times h
 CLOSEST = 0.25  # no two samples nearer than this, times h (the sampler's contract)
 FILL_RADIUS = 1.0  # gaps wider than this (times h) get extra samples
+#: a strip narrower than this (times its leading edge's step) is sampled
+#: half a step on from its leading edge: aligned, its cells were right
+#: triangles of ratio step / sqrt(step^2 + width^2), above 0.85 below 0.62
+STRIP_STAGGER = 0.65
 SLANT_STEP = 1.45  # slanted edges are sampled where rows cross them this close (times h)
 RATIO_RANGE = (0.6, 1.7)  # inside (1/sqrt(3), sqrt(3)) = (0.577, 1.732) with margin
 
@@ -333,6 +337,36 @@ def _anchor_axes(faces, dirs, family, anchor, axis_steps, ratio: float, h: float
         got = _anchored(np.array(sorted(offsets)), float(anchor[a]), axis_steps[a] / ratio, h, tol)
         if got is not None:
             anchor[a], axis_steps[a] = got[0], ratio * got[1]
+
+
+def _face_columns(face, anchor, axis_steps, ratio: float, h: float, tol: float):
+    """A planar face's own lattice along each coordinate axis (anchor,
+    steps), for the samples of its rows along that axis: anchored on its
+    straight edges across the axis (:func:`_anchored`) where they do not lie
+    on the shape's lattice (``anchor``, ``axis_steps``), which any other
+    face keeps.
+
+    An edge along a face's rows is divided into equal steps from end to
+    end.  The rows' samples stood on the shape's lattice, so a face shorter
+    than the shape along its rows (a box's side under a chamfered top edge:
+    0.388 of 0.4) ended its rows staggered against its edges' samples, a
+    little more at each step (ratios 0.87 to 1.0 up the side's vertical
+    edges); its own lattice divides the span of its edges across the axis
+    as those edges' equal steps do."""
+    if face.geomType() != "PLANE":
+        return anchor, axis_steps
+    own_anchor, own_steps = anchor.copy(), axis_steps.copy()
+    for k in range(3):
+        off = np.array(sorted(_parallel_edge_offsets(face, np.eye(3)[k], tol)))
+        hf = float(axis_steps[k]) / ratio
+        if off.size == 0 or _on_lattice(off, float(anchor[k]), hf):
+            continue
+        t0, hk = _anchored(off, float(anchor[k]), hf, h, tol) or (
+            float(off[0]),
+            _dividing_step(float(off[-1] - off[0]), h),
+        )
+        own_anchor[k], own_steps[k] = t0, ratio * hk
+    return own_anchor, own_steps
 
 
 def _face_family(face, dirs: np.ndarray, tol: float) -> int:
@@ -702,7 +736,67 @@ def _row_crossings(a, u, length, adjacent, faces, planes, step):
     return best[1], best[0], best[2]
 
 
-def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=None):
+def _polygonal(face) -> bool:
+    """Whether a face is planar and bounded by straight edges only."""
+    return face.geomType() == "PLANE" and all(e.geomType() == "LINE" for e in face.Edges())
+
+
+def _square_crossings(a, u, length, adjacent, faces, planes, axes, step):
+    """Where the lattice of an adjacent planar face (``adjacent``: indices
+    into ``faces``) meets a straight edge along or across its rows: its scan
+    planes for an edge across them, the shape's lattice along the edge's
+    coordinate axis (``axes``: anchor and steps, as the rows along that axis
+    are sampled) for an edge along them.  None where the edge's equal steps
+    are those positions already, or no such face exists.
+
+    An edge square to the rows was divided into equal steps from end to
+    end, and a face shorter than the shape (a box's side under a chamfered
+    top edge: 0.388 of 0.4; the sides of a box fused on another) ended its
+    rows staggered against those steps, a little more at each step (ratios
+    0.87 to 1.0 along the edge).  Returns the arc lengths of the samples,
+    with the ends evened by :func:`_even_ends` (the corners are sampled),
+    their spacing and the arc length of one crossing, as
+    :func:`_row_crossings` does."""
+    if planes is None or axes is None:
+        return None
+    if not all(_polygonal(faces[fi]) for fi in adjacent):
+        return None  # a face with an arc: its repair slides the arc's samples, not these
+    k = _axis_index(u)
+    for fi in adjacent:
+        f = faces[fi]
+        if f.geomType() != "PLANE":
+            continue
+        anchor, axis_steps = axes[fi]
+        d, t0, hf, _ = planes[fi]
+        along = row_cosine(f, d, u)
+        if along is None:
+            continue
+        if along < 1e-9:  # the edge across the rows: the face's scan planes
+            normal, offset, gap = d, t0, hf
+        elif along > 1 - 1e-9 and k is not None:  # along them: the axis lattice
+            normal, offset, gap = np.eye(3)[k], float(anchor[k]), float(axis_steps[k])
+        else:
+            continue
+        un = float(dot(u, normal))
+        ends = sorted((float(dot(a, normal)), float(dot(a + length * u, normal))))
+        j = np.arange(
+            math.ceil((ends[0] - offset) / gap - 1e-9),
+            math.floor((ends[1] - offset) / gap + 1e-9) + 1,
+        )
+        lattice = np.sort((offset + j * gap - float(dot(a, normal))) / un)
+        inner = lattice[(lattice > 1e-9 * length) & (lattice < length * (1 - 1e-9))]
+        m = steps(length, step)
+        even = np.arange(1, m) * (length / m)
+        if inner.size == even.size and np.allclose(inner, even, rtol=0, atol=1e-9 * length):
+            return None  # the equal steps are the lattice's crossings
+        kept = _even_ends(lattice, length, FEATURE_CLEARANCE * step)
+        if kept.size == 0:
+            return None
+        return kept, gap / abs(un), float(lattice[0])
+    return None
+
+
+def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=None, axes=None):
     """Samples on B-rep vertices and on sharp or boundary edges.
 
     Returns the samples, their faces, a dense polyline of the sampled edges,
@@ -718,11 +812,14 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
     fid: list[int] = []
     vertex_pts = [np.array(v.toTuple()) for v in occ.Vertices()]
     cos_lim = math.cos(math.radians(sharp_degrees))
-    edge_pts: list[np.ndarray] = []
-    edge_fid: list[int] = []
+    per_edge: dict[int, tuple[list[np.ndarray], int]] = {}  # edge -> its samples, face
     dense: list[tuple[float, float, float]] = [tuple(p) for p in vertex_pts]
     lattices: dict[int, list[tuple[np.ndarray, np.ndarray, float]]] = {}
-    for edge, fids, uses in zip(ef.edges, ef.faces_of, ef.uses):
+    follows = _strip_followers(ef, FEATURE_CLEARANCE * step * 2, tol)
+    # an edge following another across a strip is sampled after it
+    order = [i for i in range(len(ef.edges)) if i not in follows] + sorted(follows)
+    for ei in order:
+        edge, fids, uses = ef.edges[ei], ef.faces_of[ei], ef.uses[ei]
         length = edge.Length()
         if length <= tol:
             continue
@@ -741,26 +838,126 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
         if edge.geomType() == "LINE":
             a = np.array(edge.startPoint().toTuple())
             u = (np.array(edge.endPoint().toTuple()) - a) / length
-            cross = _row_crossings(a, u, length, fids, faces, planes, step)
+            if ei in follows and follows[ei] in per_edge:
+                lead = ef.edges[follows[ei]]
+                samples, lead_face = per_edge[follows[ei]]
+                samples = _with_corners(lead, samples, [a, a + length * u], step)
+                per_edge[follows[ei]] = (samples, lead_face)
+                cross = _across_strip(a, u, length, lead, samples, step)
+            if cross is None:
+                cross = _row_crossings(a, u, length, fids, faces, planes, step)
+            if cross is None:
+                cross = _square_crossings(a, u, length, fids, faces, planes, axes, step)
             lattice = (a, u, length / m) if cross is None else (a + cross[2] * u, u, cross[1])
             for k in fids:
                 lattices.setdefault(k, []).append(lattice)
         if cross is not None:
-            for sj in cross[0]:
-                edge_pts.append(a + sj * u)
-                edge_fid.append(first)
+            mine = [a + sj * u for sj in cross[0]]
         else:
-            for j in range(1, m):
-                edge_pts.append(np.array(edge.positionAt(j / m, mode="length").toTuple()))
-                edge_fid.append(first)
-        md = max(2, int(math.ceil(8 * length / step)))
-        dense += [edge.positionAt(j / md, mode="length").toTuple() for j in range(md + 1)]
+            mine = [np.array(edge.positionAt(j / m, mode="length").toTuple()) for j in range(1, m)]
+        per_edge[ei] = (mine, first)
+    for ei in range(len(ef.edges)):
+        if ei in per_edge:  # the dense polyline in the edges' order
+            edge = ef.edges[ei]
+            length = edge.Length()
+            md = max(2, int(math.ceil(8 * length / step)))
+            dense += [edge.positionAt(j / md, mode="length").toTuple() for j in range(md + 1)]
     for p in vertex_pts:
         pts.append(p)
         fid.append(nearest_face(p, faces))
-    pts += edge_pts
-    fid += edge_fid
+    for ei in range(len(ef.edges)):
+        if ei in per_edge:
+            mine, first = per_edge[ei]
+            pts += mine
+            fid += [first] * len(mine)
     return pts, fid, np.array(dense, dtype=np.float64).reshape(-1, 3), lattices
+
+
+def _strip_followers(ef: EdgeFaces, width: float, tol: float) -> dict[int, int]:
+    """Straight edges that follow another across a narrow planar strip
+    (edge index -> the edge it follows).
+
+    A planar face whose corners all lie within ``width`` (two clearances:
+    no scan row fits inside) of the line of one of its straight edges is a
+    strip, a chamfer's across a box's edge.  Its two long edges were
+    sampled each on its own lattice (the side's rows, the top's columns),
+    half a step apart somewhere along it (ratio 1.0).  The shorter of two
+    parallel straight edges of a strip follows the longer (the first on a
+    tie), unless that one follows another strip itself."""
+    out: dict[int, int] = {}
+    lines: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
+    for ei, e in enumerate(ef.edges):
+        if e.geomType() == "LINE" and e.Length() > tol:
+            a = np.array(e.startPoint().toTuple())
+            b = np.array(e.endPoint().toTuple())
+            lines[ei] = (a, (b - a) / norm(b - a), float(norm(b - a)))
+    by_face: dict[int, list[int]] = {}
+    for ei in lines:
+        for k in ef.faces_of[ei]:
+            by_face.setdefault(k, []).append(ei)
+    for k, mine in sorted(by_face.items()):
+        face = ef.faces[k]
+        if face.geomType() != "PLANE" or len(mine) < 2:
+            continue
+        corners = np.array([v.toTuple() for v in face.Vertices()]).reshape(-1, 3)
+        for i, e1 in enumerate(mine):
+            a1, u1, l1 = lines[e1]
+            q = corners - a1
+            off = np.linalg.norm(q - dot(q, u1)[:, None] * u1, axis=1)
+            if float(off.max()) >= width:
+                continue
+            for e2 in mine[i + 1 :]:
+                a2, u2, l2 = lines[e2]
+                gap = float(norm((a2 - a1) - dot(a2 - a1, u1) * u1))
+                if abs(abs(float(dot(u1, u2))) - 1.0) > 1e-9 or gap <= tol:
+                    continue
+                lead, follow = (e1, e2) if l1 >= l2 - tol else (e2, e1)
+                if lead not in out and follow not in out:
+                    out[follow] = lead
+    return out
+
+
+def _with_corners(lead, samples: list, corners: list, step: float) -> list:
+    """A strip's leading edge's samples with its other edge's corners
+    standing across it (:func:`_strip_followers`): each corner's foot
+    inside the edge (at least half a step from its ends) becomes a sample,
+    and the samples within ``FEATURE_CLEARANCE`` steps of it go.  A
+    chamfer's strip ends on a slanted mitre: with the side's lattice on
+    the leading edge, the strip's last cell had sides 1.02, 1.01 and 1.16
+    (ratio 0.88) and the next 1.01, 1.38, 1.40 (0.98)."""
+    a = np.array(lead.startPoint().toTuple())
+    b = np.array(lead.endPoint().toTuple())
+    length = float(norm(b - a))
+    u = (b - a) / length
+    at = np.array([float(dot(p - a, u)) for p in samples]).reshape(-1)
+    for c in corners:
+        t = float(dot(c - a, u))
+        if not 0.5 * step <= t <= length - 0.5 * step:
+            continue
+        clear = FEATURE_CLEARANCE * step
+        t = min(max(t, clear), length - clear)
+        at = np.sort(np.r_[at[np.abs(at - t) >= clear], t])
+    return [a + t * u for t in at]
+
+
+def _across_strip(a, u, length: float, lead, lead_samples, step: float):
+    """A strip's edge sampled where its leading edge's samples (and ends)
+    stand across it (:func:`_strip_followers`): the arc lengths of their
+    feet on the edge, the ends evened (:func:`_even_ends`), their spacing
+    and the arc length of one; None where none falls on it."""
+    ends = [np.array(lead.startPoint().toTuple()), np.array(lead.endPoint().toTuple())]
+    at = np.array([float(dot(p - a, u)) for p in ends + list(lead_samples)])
+    at = np.sort(at)
+    if at.size < 2:
+        return None
+    lu = (ends[1] - ends[0]) / norm(ends[1] - ends[0])
+    width = float(norm((a - ends[0]) - dot(a - ends[0], lu) * lu))
+    if width < STRIP_STAGGER * float(np.median(np.diff(at))):
+        at = (at[1:] + at[:-1]) / 2  # half a step on: isosceles cells across the strip
+    kept = _even_ends(at, length, FEATURE_CLEARANCE * step)
+    if kept.size == 0:
+        return None
+    return kept, float(np.median(np.diff(at))), float(at[0])
 
 
 def _fill_gaps(occ, faces, points: np.ndarray, h: float, size: float) -> np.ndarray:
@@ -926,13 +1123,14 @@ def scan(
                 anchor[a] = t0
                 axis_steps[a] = ratio * hf
         _anchor_axes(faces, dirs, family, anchor, axis_steps, ratio, h, tol)
+        columns = [_face_columns(f, anchor, axis_steps, ratio, h, tol) for f in faces]
         for fi, face in enumerate(faces):
             d = dirs[fam[fi]]
             t0, hf = aligned[fi]
-            planes.append((d, t0, hf, _columns(face, d, hf, ratio, anchor, axis_steps)))
+            planes.append((d, t0, hf, _columns(face, d, hf, ratio, *columns[fi])))
         with timed("sample: feature samples"):
             pts, fids, feature_curve, lattices = _feature_samples(
-                occ, EDGE_STEP * h, sharp_degrees, tol, planes
+                occ, EDGE_STEP * h, sharp_degrees, tol, planes, columns
             )
         pbar.update(1)
         n_feature = len(pts)
@@ -954,8 +1152,7 @@ def scan(
                         chain,
                         closed,
                         ratio * hf,
-                        anchor,
-                        axis_steps,
+                        *columns[fi],
                         lattices.get(fi, ()),
                         ratio,
                         sphere,
@@ -1015,6 +1212,18 @@ def scan(
             with timed("sample: planar faces"):
                 reports += repair_planar_faces(
                     occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=laid
+                )
+            with timed("sample: planar faces along square edges"):
+                # then the faces bounded by edges along or across their rows
+                # only, where their lattices stagger against an edge's samples
+                reports += repair_planar_faces(
+                    occ,
+                    bag,
+                    h,
+                    size,
+                    row_dirs=[dirs[f] for f in fam],
+                    skip=laid,
+                    squares=True,
                 )
             pbar.update(1)
             for step, lay in (

@@ -86,7 +86,7 @@ def test_sampling_logs_every_step_at_debug_level(caplog):
     steps = re.findall(r"sample: ([a-z ]+) took \d+\.\d+ s", caplog.text)
     first = ["feature samples", "scan rows", "gaps filled"]
     repairs = ["pyramids", "filleted boxes", "disks", "spherical caps", "planar faces"]
-    repairs += ["cylinders", "cones"]
+    repairs += ["planar faces along square edges", "cylinders", "cones"]
     repairs += ["bodies of revolution", "partial spheres"]
     assert steps == first + repairs + first
 

@@ -1,0 +1,131 @@
+"""Planar faces shorter than the model, edges square to the rows, booleans'
+coplanar pieces and chamfers' narrow strips (issue 23 item 2; stop 50)."""
+
+import numpy as np
+import pytest
+
+pytest.importorskip("cadquery")
+
+from sr33.samplers import shapes  # noqa: E402
+from sr33.samplers.scanline import scan  # noqa: E402
+
+
+def _box(a=0.4, b=0.4, c=0.4):
+    import cadquery as cq
+
+    return cq.Solid.makeBox(a, b, c, pnt=cq.Vector(-a / 2, -b / 2, -c / 2))
+
+
+def _chamfered_box(chamfer: float):
+    """A box 0.4 on a side with its four top edges chamfered."""
+    import cadquery as cq
+
+    return shapes.from_cad(cq.Workplane().add(_box()).edges(">Z").chamfer(chamfer).val())
+
+
+def _corner_union():
+    """A box 0.4 with a box 0.24 fused on its top corner by ``Solid.fuse``
+    (which leaves the coplanar sides in pieces)."""
+    import cadquery as cq
+
+    small = _box(0.24, 0.24, 0.24).translate(cq.Vector(-0.08, -0.08, 0.2))
+    return _box().fuse(small)
+
+
+def _worst(s, target_points: int) -> float:
+    pytest.importorskip("potpourri3d")
+    from sr33.validators.conditions import sample_conditions
+
+    r = scan(s, target_points=target_points, quiet=True)
+    return float(
+        np.nanmax(sample_conditions(r.points, s.truth_vertices, s.truth_triangles).worst_ratio)
+    )
+
+
+def test_a_boolean_leaves_no_coplanar_pieces():
+    """``from_cad`` merges the faces a fuse left in pieces on one plane
+    (13 faces -> 9); no two faces across an edge are then coplanar, and the
+    topology is the solid's."""
+    from sr33.samplers.adjacency import EdgeFaces
+
+    solid = _corner_union()
+    assert len(solid.Faces()) == 13
+    s = shapes.from_cad(solid)
+    faces = s.solid.Faces()
+    assert len(faces) == 9
+    assert s.expected.euler == 2
+    ef = EdgeFaces(s.solid)
+    for fids in ef.faces_of:
+        if len(fids) == 2 and all(faces[k].geomType() == "PLANE" for k in fids):
+            n = [np.array(faces[k].normalAt().toTuple()) for k in fids]
+            assert abs(float(n[0] @ n[1])) < 1 - 1e-9
+
+
+def test_a_faces_rows_end_on_its_edges_samples():
+    """A box's side under a chamfered top is 0.388 high of the box's 0.4:
+    its rows run up it on a lattice of its own, dividing its span as its
+    vertical edges' equal steps do, so every sample of a row stands at the
+    height of a sample of its edges (before: the box's lattice, 1.023 h
+    against the edges' 0.992 h, staggered up to half a step)."""
+    s = _chamfered_box(0.012)
+    r = scan(s, target_points=3000, repair=False, quiet=True)
+    h = r.meta["spacing"]
+    side = [
+        f
+        for f, x in enumerate(s.solid.Faces())
+        if x.geomType() == "PLANE" and abs(x.normalAt().toTuple()[0] + 1) < 1e-9
+    ][0]
+    on_side = np.abs(r.points[:, 0] + 0.2) < 1e-9
+    edge = on_side & r.on_feature & (np.abs(np.abs(r.points[:, 1]) - 0.2) < 1e-9)
+    rows = on_side & ~r.on_feature & (r.face_id == side)
+    assert edge.sum() >= 40 and rows.sum() >= 300
+    heights = np.unique(np.round(r.points[edge, 2] / h, 6))
+    gap = np.abs(r.points[rows, 2][:, None] / h - heights[None]).min(axis=1)
+    assert gap.max() < 1e-6
+
+
+@pytest.mark.parametrize("chamfer", [0.006, 0.015])
+def test_a_chamfers_strip_carries_one_lattice_across(chamfer):
+    """A chamfer's strip narrower than two clearances holds no row: its
+    shorter edge takes the longer one's samples across it, half a step on
+    where the strip is narrower than STRIP_STAGGER steps (0.006: 0.34 h
+    wide), and the box meets Condition III-ii with the margin (before:
+    0.994 and 0.96, the strip's two edges sampled on two lattices)."""
+    from sr33.samplers.scanline import STRIP_STAGGER
+
+    s = _chamfered_box(chamfer)
+    r = scan(s, target_points=3000, repair=False, quiet=True)
+    h = r.meta["spacing"]
+    p = r.points[r.on_feature]
+    # the strip along y = -0.2: its long edge at z = 0.2 - c, its short at y = -0.2 + c
+    lead = np.sort(
+        p[(np.abs(p[:, 1] + 0.2) < 1e-9) & (np.abs(p[:, 2] - (0.2 - chamfer)) < 1e-9), 0]
+    )
+    short = p[(np.abs(p[:, 1] + 0.2 - chamfer) < 1e-9) & (np.abs(p[:, 2] - 0.2) < 1e-9), 0]
+    inner = np.sort(short)[1:-1]  # the strip's corners aside
+    width = chamfer * np.sqrt(2.0)
+    across = (lead[1:] + lead[:-1]) / 2 if width < STRIP_STAGGER * h else lead
+    assert inner.size >= 15
+    assert np.abs(inner[:, None] - across[None]).min(axis=1).max() < 1e-9
+    assert _worst(s, 3000) < 0.85
+
+
+def test_a_box_fused_on_a_corner_meets_condition_iii_with_the_margin():
+    """A box 0.4 with a box 0.24 fused on its top corner (the survey's
+    boolean seam class, axis-aligned): 237 samples at or above 0.85 before
+    (0.9994), the shorter faces' rows staggered against their edges."""
+    assert _worst(shapes.from_cad(_corner_union()), 3000) < 0.85
+
+
+@pytest.mark.slow
+def test_a_box_notched_by_a_cut_meets_condition_iii_with_the_margin():
+    """A box 0.5 x 0.4 x 0.3 with a pocket cut from its top and one side
+    (1.0 before, 244 samples at or above 0.85): the pocket's walls have
+    lattices of their own, the edges between them and the L-shaped faces
+    take the lattice crossings, and a face whose lattice still staggers
+    against an edge's samples is repaired along it."""
+    import cadquery as cq
+
+    pocket = _box(0.2, 0.3, 0.25).translate(cq.Vector(-0.1, 0.05, 0.15))
+    s = shapes.from_cad(_box(0.5, 0.4, 0.3).cut(pocket))
+    assert _worst(s, 3000) < 0.85
