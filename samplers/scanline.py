@@ -802,9 +802,15 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
     Returns the samples, their faces, a dense polyline of the sampled edges,
     and per face the lattice of each of its sampled straight edges (start,
     unit direction, step): a straight edge of length L is divided into
-    ``round(L / step)`` equal steps from its start, unless ``planes`` (per
-    face, its scan planes' normal, offset and spacing) show it slanted to an
-    adjacent planar face's rows (:func:`_row_crossings`).
+    ``round(L / step)`` equal steps from its start, unless it follows
+    another across a narrow strip (:func:`_strip_followers`), or ``planes``
+    (per face, its scan planes' normal, offset, spacing and columns) show
+    it slanted to an adjacent planar face's rows (:func:`_row_crossings`),
+    or, between polygonal faces, along or across them off their lattice
+    (:func:`_square_crossings`, with ``axes``: per face, the anchor and
+    steps of its rows along each axis, :func:`_face_columns`).  Samples are
+    listed edge by edge in the shape's edge order, whatever order the edges
+    were sampled in.
     """
     ef = EdgeFaces(occ)
     faces = ef.faces
