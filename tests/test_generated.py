@@ -237,6 +237,61 @@ def _turned_cone(radius, height, angles, move):
     return shapes.from_cad(moved(solid, angles, move), name="generated")
 
 
+#: Stop 50's survey (4 models a class): a cone with a through hole along its
+#: axis (the apex cut away, a conical tube), turned, sampled conforming at
+#: 3,000 samples; the reconstruction is 1.29 h and 1.28 h from the truth
+#: (the property wants at most h).  The samplings are byte-identical on
+#: dee25de and on this stop's tip: not caused by the sampler's change, not
+#: traced.  (radius, height, hole radius, turn, move)
+CONES_WITH_A_HOLE = {
+    "acute edge": (
+        0.29121510631491776,
+        0.8707602007376759,
+        0.08736453189447532,
+        (0.68, -42.973274959768816, 85.54299674347124),
+        (1.3024913190992784, 1.401298464324817e-45, 4.52041367194856),
+    ),
+    "cone apex": (
+        0.4604403357408449,
+        0.99999,
+        0.13813210072225346,
+        (87.13609382567472, -147.3190335878659, 8.2016820334888e-241),
+        (0.008502335913301629, 1.6214784215778213, -4.720172138279821),
+    ),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    raises=AssertionError,
+    reason="issue 24, stop 50's survey: a conforming sampling of a cone with a hole "
+    "through its apex reconstructs 1.28-1.29 h from the truth; not traced",
+)
+@pytest.mark.parametrize("case", list(CONES_WITH_A_HOLE))
+def test_regression_a_cone_with_a_hole_through_its_apex_reconstructs_within_h(case):
+    import cadquery as cq
+
+    from sr33.samplers import shapes
+
+    radius, height, hole, angles, move = CONES_WITH_A_HOLE[case]
+    solid = cq.Solid.makeCone(radius, 0.0, height, pnt=cq.Vector(0, 0, -height / 2))
+    # the strategy's hole: a cylinder through the bounding box's centre, along z
+    bb = solid.BoundingBox()
+    lo = np.array([bb.xmin, bb.ymin, bb.zmin])
+    ext = np.array([bb.xmax, bb.ymax, bb.zmax]) - lo
+    tool = cq.Solid.makeCylinder(
+        hole, 3 * ext[2] + 1, pnt=cq.Vector(*(lo + ext / 2 - [0, 0, 1.5 * ext[2] + 0.5]))
+    )
+    solid = cq.Solid(solid.cut(tool).Solids()[0].wrapped)
+    shape = shapes.from_cad(moved(solid, angles, move), name="generated")
+    r = scan(shape, target_points=TARGET_POINTS)
+    why = conformance(shape, r.points, r.face_id, r.meta["spacing"])
+    if why is not None:  # not the counterexample any more: say so (not the xfail's error)
+        pytest.fail(f"the regression's sampling does not conform any more: {why}")
+    check_homeomorphism(shape, r.points, r.meta["spacing"], reconstruct(r.points, 33))
+
+
 @pytest.mark.parametrize("case", list(SLENDER_CONES))
 def test_regression_a_slender_cone_turned_off_the_axes_closes_round_its_apex(case):
     radius, angles, move = SLENDER_CONES[case]
