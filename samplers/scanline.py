@@ -690,6 +690,19 @@ def _columns(face, d, hf, ratio, anchor, axis_steps):
     return rows, float(dot(anchor, rows)), ratio * hf
 
 
+def _plane_crossings(a, u, length: float, normal, offset: float, gap: float) -> np.ndarray:
+    """Arc lengths (sorted) where the planes ``offset + j gap`` along
+    ``normal`` cross the segment from ``a`` along ``u`` (not parallel to
+    them), its ends included when a plane passes through them."""
+    un = float(dot(u, normal))
+    ends = sorted((float(dot(a, normal)), float(dot(a + length * u, normal))))
+    j = np.arange(
+        math.ceil((ends[0] - offset) / gap - 1e-9),
+        math.floor((ends[1] - offset) / gap + 1e-9) + 1,
+    )
+    return np.sort((offset + j * gap - float(dot(a, normal))) / un)
+
+
 def _row_crossings(a, u, length, adjacent, faces, planes, step):
     """Where the lattice lines of an adjacent planar face (``adjacent``:
     indices into ``faces``) cross a straight edge slanted to that face's
@@ -723,12 +736,7 @@ def _row_crossings(a, u, length, adjacent, faces, planes, step):
             spacing = gap / abs(un)
             if spacing > SLANT_STEP * step or (best is not None and spacing >= best[0] - 1e-12):
                 continue
-            ends = sorted((float(dot(a, normal)), float(dot(a + length * u, normal))))
-            j = np.arange(
-                math.ceil((ends[0] - offset) / gap - 1e-9),
-                math.floor((ends[1] - offset) / gap + 1e-9) + 1,
-            )
-            lattice = np.sort((offset + j * gap - float(dot(a, normal))) / un)
+            lattice = _plane_crossings(a, u, length, normal, offset, gap)
             if lattice.size:
                 best = (spacing, _even_ends(lattice, length, FEATURE_CLEARANCE * step), lattice[0])
     if best is None or best[1].size == 0:
@@ -741,9 +749,10 @@ def _polygonal(face) -> bool:
     return face.geomType() == "PLANE" and all(e.geomType() == "LINE" for e in face.Edges())
 
 
-def _square_crossings(a, u, length, adjacent, faces, planes, axes, step):
+def _square_crossings(a, u, length, adjacent, faces, polygonal, planes, axes, step):
     """Where the lattice of an adjacent planar face (``adjacent``: indices
-    into ``faces``) meets a straight edge along or across its rows: its scan
+    into ``faces``; ``polygonal``: per face, :func:`_polygonal`) meets a
+    straight edge along or across its rows: its scan
     planes for an edge across them, the shape's lattice along the edge's
     coordinate axis (``axes``: anchor and steps, as the rows along that axis
     are sampled) for an edge along them.  None where the edge's equal steps
@@ -759,7 +768,7 @@ def _square_crossings(a, u, length, adjacent, faces, planes, axes, step):
     :func:`_row_crossings` does."""
     if planes is None or axes is None:
         return None
-    if not all(_polygonal(faces[fi]) for fi in adjacent):
+    if not all(polygonal[fi] for fi in adjacent):
         return None  # a face with an arc: its repair slides the arc's samples, not these
     k = _axis_index(u)
     for fi in adjacent:
@@ -778,12 +787,7 @@ def _square_crossings(a, u, length, adjacent, faces, planes, axes, step):
         else:
             continue
         un = float(dot(u, normal))
-        ends = sorted((float(dot(a, normal)), float(dot(a + length * u, normal))))
-        j = np.arange(
-            math.ceil((ends[0] - offset) / gap - 1e-9),
-            math.floor((ends[1] - offset) / gap + 1e-9) + 1,
-        )
-        lattice = np.sort((offset + j * gap - float(dot(a, normal))) / un)
+        lattice = _plane_crossings(a, u, length, normal, offset, gap)
         inner = lattice[(lattice > 1e-9 * length) & (lattice < length * (1 - 1e-9))]
         m = steps(length, step)
         even = np.arange(1, m) * (length / m)
@@ -822,6 +826,7 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
     dense: list[tuple[float, float, float]] = [tuple(p) for p in vertex_pts]
     lattices: dict[int, list[tuple[np.ndarray, np.ndarray, float]]] = {}
     follows = _strip_followers(ef, FEATURE_CLEARANCE * step * 2, tol)
+    polygonal = [_polygonal(f) for f in faces]
     # an edge following another across a strip is sampled after it
     order = [i for i in range(len(ef.edges)) if i not in follows] + sorted(follows)
     for ei in order:
@@ -853,7 +858,7 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
             if cross is None:
                 cross = _row_crossings(a, u, length, fids, faces, planes, step)
             if cross is None:
-                cross = _square_crossings(a, u, length, fids, faces, planes, axes, step)
+                cross = _square_crossings(a, u, length, fids, faces, polygonal, planes, axes, step)
             lattice = (a, u, length / m) if cross is None else (a + cross[2] * u, u, cross[1])
             for k in fids:
                 lattices.setdefault(k, []).append(lattice)
@@ -862,20 +867,16 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
         else:
             mine = [np.array(edge.positionAt(j / m, mode="length").toTuple()) for j in range(1, m)]
         per_edge[ei] = (mine, first)
-    for ei in range(len(ef.edges)):
-        if ei in per_edge:  # the dense polyline in the edges' order
-            edge = ef.edges[ei]
-            length = edge.Length()
-            md = max(2, int(math.ceil(8 * length / step)))
-            dense += [edge.positionAt(j / md, mode="length").toTuple() for j in range(md + 1)]
     for p in vertex_pts:
         pts.append(p)
         fid.append(nearest_face(p, faces))
-    for ei in range(len(ef.edges)):
-        if ei in per_edge:
-            mine, first = per_edge[ei]
-            pts += mine
-            fid += [first] * len(mine)
+    for ei in sorted(per_edge):  # the samples and the dense polyline in the edges' order
+        mine, first = per_edge[ei]
+        pts += mine
+        fid += [first] * len(mine)
+        edge = ef.edges[ei]
+        md = max(2, int(math.ceil(8 * edge.Length() / step)))
+        dense += [edge.positionAt(j / md, mode="length").toTuple() for j in range(md + 1)]
     return pts, fid, np.array(dense, dtype=np.float64).reshape(-1, 3), lattices
 
 
