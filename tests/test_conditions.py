@@ -383,3 +383,65 @@ def test_geodesic_lengths_do_not_hang_on_the_solvers_direction():
     chord = np.linalg.norm(p[a] - p[b], axis=1)[both]
     assert (rep.edge_length[both] <= 1.01 * chord).all()
     assert rep.epsilon < 0.01  # Condition II's epsilon read the detour too (0.458)
+
+
+def _box_lattice(thickness):
+    """A 1 x 1 x ``thickness`` box: its surface mesh and the samples of the
+    0.1 lattice on it (every lattice point on the box's boundary)."""
+    box = pv.Box(bounds=(0, 1, 0, 1, 0, thickness), level=0).triangulate()
+    v, f = np.asarray(box.points, float), np.asarray(box.faces).reshape(-1, 4)[:, 1:]
+    xs = np.linspace(0, 1, 11)
+    zs = np.linspace(0, thickness, max(2, round(thickness / 0.1) + 1))
+    g = np.stack(np.meshgrid(xs, xs, zs, indexing="ij"), -1).reshape(-1, 3)
+    on = (
+        np.isclose(g, 0).any(axis=1)
+        | np.isclose(g[:, :2], 1).any(axis=1)
+        | np.isclose(g[:, 2], thickness)
+    )
+    return g[on], v, f
+
+
+def test_ii_i_breaks_where_a_plates_other_side_joins_the_neighbourhood():
+    # a plate one spacing thick: N(u; 33) of a sample in the middle takes the
+    # other side's samples, 0.1 away through the plate, > 1 round its rim
+    p, v, f = _box_lattice(0.1)
+    rep = sample_conditions(p, v, f)
+    bad = rep.ii_i_violations()
+    rim = np.minimum(np.minimum(p[:, 0], 1 - p[:, 0]), np.minimum(p[:, 1], 1 - p[:, 1]))
+    assert set(np.flatnonzero(rim >= 0.35 - 1e-9)) <= set(bad.tolist())  # the middle: all
+    assert rim[bad].min() > 0.15  # near the rim, the other side is near round it too
+    assert np.isinf(rep.reach[bad]).all()
+    rows = {r[0][:6]: r for r in rep.table()}
+    assert rows["II-i  "][1] == "FAIL" and rows["II-i  "][2] == f"{bad.size} samples"
+    assert rows["II-i  "][0] == "II-i   N(u;k) on one piece of M"
+
+
+def test_ii_i_holds_on_a_cube_round_its_right_angled_edges():
+    p, v, f = _box_lattice(1.0)
+    rep = sample_conditions(p, v, f)
+    assert rep.ii_i_violations().size == 0
+    # round a right-angled edge a neighbour is at most about √2 R_u away along M
+    assert 1.0 <= rep.reach.max() < 1.6
+    rows = {r[0][:6]: r for r in rep.table()}
+    assert rows["II-i  "][1] == "pass"
+
+
+def test_neighbourhood_reach_ties_and_order():
+    # the k-th neighbour's ties all join N(u; k), so the answer does not
+    # depend on the samples' order; on a flat lattice with its Delaunay
+    # edges (Euclidean lengths) every neighbour is reached within 1.5 R_u
+    from scipy.spatial import Delaunay
+
+    from sr33.validators.conditions import neighbourhood_reach
+
+    xs = np.arange(12.0)
+    p = np.stack(np.meshgrid(xs, xs, [0.0]), -1).reshape(-1, 3)
+    tri = Delaunay(p[:, :2]).simplices
+    e = np.unique(np.sort(np.vstack([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), 1), axis=0)
+    w = np.linalg.norm(p[e[:, 0]] - p[e[:, 1]], axis=1)
+    reach = neighbourhood_reach(p, e, w, 33)
+    assert np.isfinite(reach).all() and 1.0 <= reach.min() and reach.max() < 1.5
+    perm = np.random.default_rng(3).permutation(len(p))
+    inv = np.argsort(perm)
+    again = neighbourhood_reach(p[perm], inv[e], w, 33)
+    np.testing.assert_array_equal(again[inv], reach)
