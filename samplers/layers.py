@@ -53,7 +53,7 @@ from .faces import (
     steps,
     whole_band,
 )
-from .repair import BAD, GAP, MOVABLE, RETRY_BAD, Repaired, copies, repair, split_corners
+from .repair import BAD, GAP, MOVABLE, RETRY_BAD, Repaired, copies, glued, repair, split_corners
 from .rings import HALVING_GAP, ring_positions
 from .samples import Samples
 
@@ -1343,7 +1343,7 @@ def _repair_developed(
     # where the rings break Condition III-ii: the triangles to mend (across the
     # cut too: every sample's images turned by the sector's angle either way)
     turn = None if full else theta
-    pts = np.vstack(copies(allp, turn))
+    pts = glued(allp, turn)
     tri = Delaunay(pts).simplices
     tri = tri[inside(pts[tri].mean(axis=1))]
     broken = pts[tri[triangle_ratios(pts, tri) >= broken_at]].mean(axis=1)

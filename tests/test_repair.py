@@ -1,5 +1,7 @@
 """samplers.repair: Condition III-ii restored around a circle, deterministically."""
 
+import math
+
 import numpy as np
 import pytest
 from scipy.spatial import Delaunay, cKDTree
@@ -364,3 +366,35 @@ def test_the_repairs_vectorised_sums_and_edges_keep_the_bits():
     for k, ln in enumerate(lines):
         one_by_one[which == k] = ln.project(p[which == k], 0.05)
     assert layers._project_onto(lines, 0.05)(p).tobytes() == one_by_one.tobytes()
+
+
+@pytest.mark.parametrize("degrees", [90.0, 119.0, 181.39356918867102, 250.0])
+def test_a_developments_images_fill_the_wedge_outside_it_once(degrees):
+    # rings of samples about a cone's apex on its development (the sector of
+    # ``degrees`` whose sides are glued): the images across the sides stand
+    # outside the sector, fill the wedge there, and overlap none of the
+    # sector's samples (a conebox's 181° development once
+    # had images 2.8° inside the sector: triangles of 0.9 along its cut)
+    from sr33.samplers.repair import glued
+
+    theta = math.radians(degrees)
+    p = [np.zeros((1, 2))]
+    for r in np.arange(1.0, 21.0):
+        a = (np.arange(max(3, int(r * theta))) + 0.5) / max(3, int(r * theta)) * theta
+        p.append(np.c_[r * np.cos(a), r * np.sin(a)])
+    p = np.vstack(p)
+    g = glued(p, theta)
+    images = g[p.shape[0] :]
+    ang = np.arctan2(images[:, 1], images[:, 0]) % (2 * math.pi)
+    r = np.linalg.norm(images, axis=1)
+    assert (ang[r > 0] >= theta).all()  # outside the sector
+    # no image on a sample of the sector (the two sides' images meet halfway
+    # round the wedge, as the sides meet at the cut)
+    assert cKDTree(p).query(images[r > 0])[0].min() > 0.3
+    # the wedge [theta, 2 pi) is filled where the sector is wide enough to
+    # fill it (120° or more): every ring's images span it, their arcs apart
+    # at most about twice the ring's (1.05 or less) where the sides meet
+    for ring in np.arange(3.0, 21.0) if theta >= 2 * math.pi / 3 else ():
+        on = np.isclose(r, ring)
+        gaps = np.diff(np.sort(np.r_[ang[on], theta, 2 * math.pi]))
+        assert gaps.max() * ring < 2.2
