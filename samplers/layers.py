@@ -959,6 +959,96 @@ def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) ->
     return float(np.r_[triangle_ratios(uv, tri[judged]), 0.0].max())
 
 
+def _apex_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) -> float:
+    """The worst Condition III-ii ratio of the intrinsic Delaunay triangles
+    round a cone's apex (centroid within ``APEX_JUDGED_FROM`` t of it), the
+    apex a sample: what :func:`_developed_worst` leaves out.
+
+    No planar picture of a cone holds its Delaunay triangles round the apex
+    (a circle there may take in the apex, and the cone's disk then wraps
+    round it).  So the samples within ``APEX_JUDGED_FROM + 3`` t of the apex
+    are triangulated on the development opened out to a whole turn (angles
+    times 2π / its angle: a picture of the cone round its apex, not an
+    isometric one), every edge given its length on the cone (the chord
+    across its angle on the development), and the edges flipped until every
+    one is Delaunay by those lengths (its two opposite angles sum to π or
+    less): the intrinsic Delaunay triangulation (the apex a vertex, every
+    triangle flat).  A turned conebox's 181° cone had a sliver of 0.979
+    there (0.911 before its development was glued without overlap) that no
+    planar picture shows.
+    """
+    theta = 2 * math.pi * sin_a
+    r = np.r_[0.0, rho, np.full(len(rim_ang), slant)]
+    psi = np.r_[0.0, np.asarray(ang) * sin_a, np.asarray(rim_ang) * sin_a] % theta
+    zone = r < (APEX_JUDGED_FROM + 3.0) * t
+    r, psi = r[zone], psi[zone]
+    if r.size < 4:
+        return 0.0
+    phi = psi * (2 * math.pi / theta)
+    tri = Delaunay(np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)).simplices
+
+    def chord(i: int, j: int) -> float:
+        d = abs(psi[i] - psi[j]) % theta
+        d = min(d, theta - d)
+        return math.sqrt(max(r[i] ** 2 + r[j] ** 2 - 2 * r[i] * r[j] * math.cos(d), 0.0))
+
+    length: dict[tuple[int, int], float] = {}
+    on: dict[tuple[int, int], set[int]] = {}
+    tris: list[list[int]] = [list(map(int, x)) for x in tri]
+    for ti, x in enumerate(tris):
+        for k in range(3):
+            e = tuple(sorted((x[k], x[(k + 1) % 3])))
+            length.setdefault(e, chord(*e))
+            on.setdefault(e, set()).add(ti)
+
+    def opposite(ti: int, e: tuple[int, int]) -> int:
+        return next(v for v in tris[ti] if v not in e)
+
+    def angle(a: float, b: float, c: float) -> float:  # at the corner facing c
+        return math.acos(max(-1.0, min(1.0, (a * a + b * b - c * c) / (2 * a * b))))
+
+    todo = list(on)
+    for _ in range(50 * len(tris)):
+        if not todo:
+            break
+        e = todo.pop()
+        if e not in on or len(on[e]) != 2:
+            continue
+        t1, t2 = sorted(on[e])
+        i, j = e
+        k, m = opposite(t1, e), opposite(t2, e)
+        lij = length[e]
+        lik, ljk = length[tuple(sorted((i, k)))], length[tuple(sorted((j, k)))]
+        lim, ljm = length[tuple(sorted((i, m)))], length[tuple(sorted((j, m)))]
+        if angle(lik, ljk, lij) + angle(lim, ljm, lij) <= math.pi + 1e-9:
+            continue
+        new = tuple(sorted((k, m)))
+        if new in on:  # two edges on one pair: not flipped
+            continue
+        # the two triangles laid out on either side of e: the new edge's length
+        xk = (lik**2 - ljk**2 + lij**2) / (2 * lij)
+        xm = (lim**2 - ljm**2 + lij**2) / (2 * lij)
+        yk = math.sqrt(max(lik**2 - xk**2, 0.0))
+        ym = -math.sqrt(max(lim**2 - xm**2, 0.0))
+        length[new] = math.hypot(xk - xm, yk - ym)
+        del on[e]
+        tris[t1], tris[t2] = [i, m, k], [j, k, m]
+        im, jk = tuple(sorted((i, m))), tuple(sorted((j, k)))
+        on[im].discard(t2)
+        on[im].add(t1)
+        on[jk].discard(t1)
+        on[jk].add(t2)
+        on[new] = {t1, t2}
+        todo.extend([im, jk, tuple(sorted((i, k))), tuple(sorted((j, m)))])
+    worst = 0.0
+    for x in tris:
+        if np.mean(r[x]) >= APEX_JUDGED_FROM * t:
+            continue
+        sides = sorted(length[tuple(sorted((x[q], x[(q + 1) % 3])))] for q in range(3))
+        worst = max(worst, sides[1] / sides[2])
+    return worst
+
+
 def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float, inner, limits):
     """The rings of :func:`lattice_cone_faces` from the rim to the apex, repaired.
 
@@ -1019,6 +1109,8 @@ def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float,
         )
         got = wide if wide[4] < got[4] else got
     judged = _developed_worst(got[0], got[1], rim_ang, slant, sin_a, t)
+    if inner is None:
+        judged = max(judged, _apex_worst(got[0], got[1], rim_ang, slant, sin_a, t))
     return _ConeRings(got[0], got[1], got[2], nrows, got[3], got[4], judged)
 
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
-from sr33.mesh import SQRT3_2, as_mesh, triangle_ratios, unique_rows
+from sr33.mesh import SQRT3_2, as_mesh, edge_incidence, half_edges, triangle_ratios, unique_rows
 
 OFF_TRUTH = 0.1  # h: farther from the truth, a sample is measured where it snaps, not where it is
 OFF_FRAME = 1.0  # h: a median this far off is another frame or unit, not a sampling
@@ -547,8 +547,8 @@ def _labelled_delaunay(tv, tf, snap, pts, sharp_degrees):
     """DT_M from the nearest-sample labels of the truth's vertices.
 
     Returns the DT_M edges (sorted pairs), per edge the number of truth edges
-    joining its two cells (the length of its dual Voronoi edge, in mesh edges)
-    and the DT_M triangles (sorted triples).
+    joining its two cells (the length of its dual Voronoi edge, in mesh edges),
+    the DT_M triangles (sorted triples) and every truth vertex's label.
     """
     e = np.concatenate([tf[:, [0, 1]], tf[:, [1, 2]], tf[:, [2, 0]]])
     e = unique_rows(np.sort(e, axis=1))
@@ -561,7 +561,7 @@ def _labelled_delaunay(tv, tf, snap, pts, sharp_degrees):
     lt = label_of_vertex[tf]
     three = (lt[:, 0] != lt[:, 1]) & (lt[:, 1] != lt[:, 2]) & (lt[:, 0] != lt[:, 2])
     dt_tri = unique_rows(np.sort(lt[three], axis=1).reshape(-1, 3))
-    return dt_edges.reshape(-1, 2), crossings, dt_tri
+    return dt_edges.reshape(-1, 2), crossings, dt_tri, label_of_vertex
 
 
 SETTLE = 8  # a cell the labels cannot close is labelled again this many times finer
@@ -620,7 +620,7 @@ def _settle(pts, tv, tf, snap, orphans, dt, resolution, sharp_degrees):
     remap[used] = np.arange(used.size)
     ids = np.flatnonzero(remap[snap] >= 0)
     rv, rt = refine_to_edge_length(tv[used], remap[ct], resolution / SETTLE)
-    le, lc, lt = _labelled_delaunay(rv, rt, remap[snap[ids]], pts[ids], sharp_degrees)
+    le, lc, lt, _ = _labelled_delaunay(rv, rt, remap[snap[ids]], pts[ids], sharp_degrees)
     le, lt = ids[le], ids[lt]
     old_e = inner[dt_edges].all(axis=1)
     new_e = inner[le].all(axis=1)
@@ -661,7 +661,38 @@ def _angle(x, y, z) -> np.ndarray:
     return np.arccos(np.clip((x * x + y * y - z * z) / (2.0 * x * y), -1.0, 1.0))
 
 
-def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8):
+def _cell_curvature(tv, tf, label, snap, n: int) -> np.ndarray:
+    """Per sample, the truth's total absolute Gaussian curvature in its
+    geodesic Voronoi cell: the angle defects (2π less the angles round a
+    vertex; none at a boundary vertex) of the truth vertices labelled with
+    it, but for the vertex at the sample itself (a cone's apex, a box's
+    corner sampled there: every triangle at it stays flat).  On the
+    piecewise-flat truth the curvature sits at its vertices, so a quad of
+    DT_M triangles whose four cells hold none is flat: its developed angles
+    are exact."""
+    corner = tv[tf]
+    ang = np.stack(
+        [
+            _angle(
+                np.linalg.norm(corner[:, j] - corner[:, (j + 1) % 3], axis=1),
+                np.linalg.norm(corner[:, j] - corner[:, (j + 2) % 3], axis=1),
+                np.linalg.norm(corner[:, (j + 1) % 3] - corner[:, (j + 2) % 3], axis=1),
+            )
+            for j in range(3)
+        ],
+        axis=1,
+    )
+    total = np.bincount(tf.ravel(), weights=ang.ravel(), minlength=tv.shape[0])
+    inc = edge_incidence(*half_edges(tf))
+    boundary = np.zeros(tv.shape[0], dtype=bool)
+    boundary[inc.edges[inc.counts == 1].ravel()] = True
+    defect = np.where(boundary, 0.0, np.abs(2 * np.pi - total))
+    defect[snap] = 0.0
+    ok = label >= 0
+    return np.bincount(label[ok], weights=defect[ok], minlength=n)
+
+
+def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8, curvature=None):
     """Decide the near ties of DT_M, and mend the labels' plain errors, by
     the intrinsic Delaunay criterion.
 
@@ -700,7 +731,10 @@ def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8):
         tie = cross[np.searchsorted(code, q[:, 0] * n + q[:, 1])] <= TIE_CROSSINGS
         excess = _angle(ac, bc, ab) + _angle(ad, bd, ab) - np.pi
         cd = np.minimum(q[:, 2], q[:, 3]) * n + np.maximum(q[:, 2], q[:, 3])
-        bar = np.where(tie | exact, 1e-9, math.radians(FLIP_MARGIN))
+        bar = np.full(q.shape[0], math.radians(FLIP_MARGIN))
+        if curvature is not None:  # flat between (no curvature in the cells): exact
+            bar = np.minimum(bar, np.maximum(curvature[q].sum(axis=1), 1e-9))
+        bar = np.where(tie | exact, 1e-9, bar)
         flips = q[(excess > bar) & ~np.isin(cd, code)]
         if flips.size == 0:
             break
@@ -929,7 +963,8 @@ def sample_conditions(
                 "the samples must lie on the truth's surface"
             ) from exc
     with timed("conditions: labels"):
-        dt_edges, crossings, dt_tri = _labelled_delaunay(tv, tf, snap, pts, sharp_degrees)
+        dt_edges, crossings, dt_tri, label = _labelled_delaunay(tv, tf, snap, pts, sharp_degrees)
+        curvature = _cell_curvature(tv, tf, label, snap, n)
         orphans = np.setdiff1d(np.arange(n), dt_tri)
         if orphans.size and dt_tri.size:
             dt_edges, crossings, dt_tri = _settle(
@@ -941,7 +976,7 @@ def sample_conditions(
     if flip_ties:
         with timed("conditions: angle test"):
             dt_edges, crossings, dt_tri = _flip_to_delaunay(
-                pts, (dt_edges, crossings, dt_tri), geodesics
+                pts, (dt_edges, crossings, dt_tri), geodesics, curvature=curvature
             )
     length = geodesics(dt_edges)
     key = dt_edges[:, 0] * n + dt_edges[:, 1]
