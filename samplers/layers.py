@@ -959,6 +959,90 @@ def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) ->
     return float(np.r_[triangle_ratios(uv, tri[judged]), 0.0].max())
 
 
+def _apex_triangulation(rho, ang, rim_ang, slant: float, sin_a: float, t: float):
+    """The intrinsic Delaunay triangulation of a cone's samples within
+    ``APEX_JUDGED_FROM + 3`` t of its apex (the apex sample 0), for
+    :func:`_apex_worst`: their slant distances, the triangles (sample
+    triples, counter-clockwise on the cone), the lengths on the cone of
+    their sides (side q from corner q to corner q + 1) and the number of
+    flips it took from the opened-out picture's triangulation.  Edges are
+    kept by identity, not by their two samples: round a narrow cone's apex
+    two samples may be joined by two edges, one either side of it."""
+    theta = 2 * math.pi * sin_a
+    r = np.r_[0.0, rho, np.full(len(rim_ang), slant)]
+    psi = np.r_[0.0, np.asarray(ang) * sin_a, np.asarray(rim_ang) * sin_a] % theta
+    zone = r < (APEX_JUDGED_FROM + 3.0) * t
+    r, psi = r[zone], psi[zone]
+    if r.size < 4:
+        return r, np.empty((0, 3), np.int64), np.empty((0, 3)), 0
+    phi = psi * (2 * math.pi / theta)
+    xy = np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)
+    tri = Delaunay(xy).simplices
+    d1, d2 = xy[tri[:, 1]] - xy[tri[:, 0]], xy[tri[:, 2]] - xy[tri[:, 0]]
+    clockwise = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0] < 0
+    tri[clockwise] = tri[clockwise][:, ::-1]
+
+    def chord(i: int, j: int) -> float:  # the opened picture's edges: the shorter way
+        d = abs(psi[i] - psi[j]) % theta
+        d = min(d, theta - d)
+        return math.sqrt(max(r[i] ** 2 + r[j] ** 2 - 2 * r[i] * r[j] * math.cos(d), 0.0))
+
+    corners: list[list[int]] = [list(map(int, x)) for x in tri]
+    sides: list[list[int]] = []  # per triangle the edge of side q
+    length: list[float] = []
+    faces: list[list[int]] = []  # per edge its triangles
+    first: dict[tuple[int, int], int] = {}
+    for ti, x in enumerate(corners):
+        ids = []
+        for q in range(3):
+            key = tuple(sorted((x[q], x[(q + 1) % 3])))
+            if key not in first:
+                first[key] = len(length)
+                length.append(chord(*key))
+                faces.append([])
+            ids.append(first[key])
+            faces[first[key]].append(ti)
+        sides.append(ids)
+
+    def angle(a: float, b: float, c: float) -> float:  # at the corner facing c
+        return math.acos(max(-1.0, min(1.0, (a * a + b * b - c * c) / (2 * a * b))))
+
+    todo = list(range(len(length)))
+    flips = 0
+    for _ in range(50 * len(corners)):
+        if not todo:
+            break
+        e = todo.pop()
+        if len(faces[e]) != 2:
+            continue
+        t1, t2 = faces[e]
+        q1, q2 = sides[t1].index(e), sides[t2].index(e)
+        a, b, k = (corners[t1][(q1 + j) % 3] for j in range(3))
+        m = corners[t2][(q2 + 2) % 3]
+        e_bk, e_ka = sides[t1][(q1 + 1) % 3], sides[t1][(q1 + 2) % 3]
+        e_am, e_mb = sides[t2][(q2 + 1) % 3], sides[t2][(q2 + 2) % 3]
+        lab, lbk, lka, lam, lmb = (length[x] for x in (e, e_bk, e_ka, e_am, e_mb))
+        if k == m or angle(lbk, lka, lab) + angle(lam, lmb, lab) <= math.pi + 1e-9:
+            continue
+        # the two triangles laid out either side of a -> b: the new edge k - m
+        xk = (lka**2 - lbk**2 + lab**2) / (2 * lab)
+        xm = (lam**2 - lmb**2 + lab**2) / (2 * lab)
+        yk = math.sqrt(max(lka**2 - xk**2, 0.0))
+        ym = -math.sqrt(max(lam**2 - xm**2, 0.0))
+        new = len(length)
+        length.append(math.hypot(xk - xm, yk - ym))
+        faces.append([t1, t2])
+        faces[e] = []
+        corners[t1], sides[t1] = [a, m, k], [e_am, new, e_ka]
+        corners[t2], sides[t2] = [m, b, k], [e_mb, e_bk, new]
+        faces[e_am] = [t1 if x == t2 else x for x in faces[e_am]]
+        faces[e_bk] = [t2 if x == t1 else x for x in faces[e_bk]]
+        flips += 1
+        todo.extend([e_am, e_mb, e_bk, e_ka])
+    lengths = np.array([[length[x] for x in ids] for ids in sides])
+    return r, np.array(corners, dtype=np.int64), lengths, flips
+
+
 def _apex_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) -> float:
     """The worst Condition III-ii ratio of the intrinsic Delaunay triangles
     round a cone's apex (centroid within ``APEX_JUDGED_FROM`` t of it), the
@@ -977,76 +1061,12 @@ def _apex_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) -> floa
     there (0.911 before its development was glued without overlap) that no
     planar picture shows.
     """
-    theta = 2 * math.pi * sin_a
-    r = np.r_[0.0, rho, np.full(len(rim_ang), slant)]
-    psi = np.r_[0.0, np.asarray(ang) * sin_a, np.asarray(rim_ang) * sin_a] % theta
-    zone = r < (APEX_JUDGED_FROM + 3.0) * t
-    r, psi = r[zone], psi[zone]
-    if r.size < 4:
+    r, tris, lengths, _ = _apex_triangulation(rho, ang, rim_ang, slant, sin_a, t)
+    judged = r[tris].mean(axis=1) < APEX_JUDGED_FROM * t if tris.size else np.empty(0, bool)
+    if not judged.any():
         return 0.0
-    phi = psi * (2 * math.pi / theta)
-    tri = Delaunay(np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)).simplices
-
-    def chord(i: int, j: int) -> float:
-        d = abs(psi[i] - psi[j]) % theta
-        d = min(d, theta - d)
-        return math.sqrt(max(r[i] ** 2 + r[j] ** 2 - 2 * r[i] * r[j] * math.cos(d), 0.0))
-
-    length: dict[tuple[int, int], float] = {}
-    on: dict[tuple[int, int], set[int]] = {}
-    tris: list[list[int]] = [list(map(int, x)) for x in tri]
-    for ti, x in enumerate(tris):
-        for k in range(3):
-            e = tuple(sorted((x[k], x[(k + 1) % 3])))
-            length.setdefault(e, chord(*e))
-            on.setdefault(e, set()).add(ti)
-
-    def opposite(ti: int, e: tuple[int, int]) -> int:
-        return next(v for v in tris[ti] if v not in e)
-
-    def angle(a: float, b: float, c: float) -> float:  # at the corner facing c
-        return math.acos(max(-1.0, min(1.0, (a * a + b * b - c * c) / (2 * a * b))))
-
-    todo = list(on)
-    for _ in range(50 * len(tris)):
-        if not todo:
-            break
-        e = todo.pop()
-        if e not in on or len(on[e]) != 2:
-            continue
-        t1, t2 = sorted(on[e])
-        i, j = e
-        k, m = opposite(t1, e), opposite(t2, e)
-        lij = length[e]
-        lik, ljk = length[tuple(sorted((i, k)))], length[tuple(sorted((j, k)))]
-        lim, ljm = length[tuple(sorted((i, m)))], length[tuple(sorted((j, m)))]
-        if angle(lik, ljk, lij) + angle(lim, ljm, lij) <= math.pi + 1e-9:
-            continue
-        new = tuple(sorted((k, m)))
-        if new in on:  # two edges on one pair: not flipped
-            continue
-        # the two triangles laid out on either side of e: the new edge's length
-        xk = (lik**2 - ljk**2 + lij**2) / (2 * lij)
-        xm = (lim**2 - ljm**2 + lij**2) / (2 * lij)
-        yk = math.sqrt(max(lik**2 - xk**2, 0.0))
-        ym = -math.sqrt(max(lim**2 - xm**2, 0.0))
-        length[new] = math.hypot(xk - xm, yk - ym)
-        del on[e]
-        tris[t1], tris[t2] = [i, m, k], [j, k, m]
-        im, jk = tuple(sorted((i, m))), tuple(sorted((j, k)))
-        on[im].discard(t2)
-        on[im].add(t1)
-        on[jk].discard(t1)
-        on[jk].add(t2)
-        on[new] = {t1, t2}
-        todo.extend([im, jk, tuple(sorted((i, k))), tuple(sorted((j, m)))])
-    worst = 0.0
-    for x in tris:
-        if np.mean(r[x]) >= APEX_JUDGED_FROM * t:
-            continue
-        sides = sorted(length[tuple(sorted((x[q], x[(q + 1) % 3])))] for q in range(3))
-        worst = max(worst, sides[1] / sides[2])
-    return worst
+    sides = np.sort(lengths[judged], axis=1)
+    return float((sides[:, 1] / sides[:, 2]).max())
 
 
 def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float, inner, limits):
