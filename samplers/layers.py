@@ -1016,6 +1016,8 @@ def _apex_triangulation(rho, ang, rim_ang, slant: float, sin_a: float, t: float)
         if len(faces[e]) != 2:
             continue
         t1, t2 = faces[e]
+        if t1 == t2:  # an edge a triangle meets on two sides (round the apex)
+            continue
         q1, q2 = sides[t1].index(e), sides[t2].index(e)
         a, b, k = (corners[t1][(q1 + j) % 3] for j in range(3))
         m = corners[t2][(q2 + 2) % 3]

@@ -155,7 +155,7 @@ class ConditionReport:
         Condition II-i as measured (:func:`neighbourhood_reach`): per sample
         u, the longest DT_M path from u to a sample of N(u; k), over
         N(u; k)'s radius; inf where one lies beyond :data:`REACH` radii (on
-        another part of the surface); NaN where not measured.
+        another part of the surface); None where not measured.
     """
 
     off_truth: np.ndarray
@@ -705,7 +705,12 @@ def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8, curvature
     lengths are all exact (chords that lie on the surface: the quad lies on
     one flat face, where DT_M is the plane's Delaunay triangulation), is
     flipped at any excess over π (a sum within 1e-9 of π, truly cocircular
-    samples, keeps the labelled diagonal); any other edge only at an excess over
+    samples, keeps the labelled diagonal); with ``curvature`` (per sample,
+    :func:`_cell_curvature`) an edge at an excess over the curvature in its
+    quad's four cells (the developed angles' error; none where the truth is
+    flat between the samples, as on a cylinder or round a sampled cone apex:
+    a turned conebox's apex read 0.979 on a sliver 3.4° from Delaunay), up
+    to ``FLIP_MARGIN``; any other edge only at an excess over
     ``FLIP_MARGIN``: there the labels took a diagonal that is plainly not
     Delaunay (Dijkstra's distances along the mesh edges run a few percent
     long, which moves the cells' borders where samples crowd, as round a
