@@ -1562,9 +1562,11 @@ def _repair_pole(
     after the last.  Returns the rings replaced, per new sample its
     (distance from the pole, angle) and ring (-1 for an added sample), and
     a report (for an apex with the second repair's ``margin_bad`` and
-    ``margin_worst``); or ``([], [], [], None)`` when the face at that end
-    is neither a sphere nor a cone with a fan for its angle (its apex stays
-    as laid out), or the face or the body is too short.  ``memo`` (shared
+    ``margin_worst``, and ``apex_worst``, its intrinsic Delaunay triangles'
+    worst ratio round the apex, :func:`_apex_worst`); or
+    ``([], [], [], None)`` when the face at that end is neither a sphere
+    nor a cone with a fan for its angle (its apex stays as laid out), or the
+    face or the body is too short.  ``memo`` (shared
     by a body's two poles) keeps each repair's answer by its input: a ball's
     poles, mirror images with the same rings, are repaired once (sphere
     24 s -> 12 s).
@@ -1610,6 +1612,8 @@ def _repair_pole(
             r2, a2, own, *margin = _repair_developed(
                 r2, a2, own, columns[rim], float(reach), sin_a, 1.0, APEX_SETTLED, APEX_BROKEN
             )
+            # and round the apex by the cone's own Delaunay triangles
+            margin.append(_apex_worst(r2, a2, columns[rim], float(reach), sin_a, 1.0))
         if memo is not None:
             memo[key] = (r2, a2, own, bad, worst, margin)
     row2 = np.where(own >= 0, row_a[np.maximum(own, 0)], -1)
@@ -1624,7 +1628,9 @@ def _repair_pole(
         "worst": float(worst),
     }
     if margin is not None:
-        report.update(margin_bad=int(margin[0]), margin_worst=float(margin[1]))
+        report.update(
+            margin_bad=int(margin[0]), margin_worst=float(margin[1]), apex_worst=float(margin[2])
+        )
     return inner, list(zip(r2.tolist(), a2.tolist())), row2.tolist(), report
 
 
@@ -1742,7 +1748,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         ]
         # what each repair was left with (an apex: after its second repair)
         left = [
-            rep.get("margin_worst", rep["worst"])
+            max(rep.get("margin_worst", rep["worst"]), rep.get("apex_worst", 0.0))
             for _, (_, _, _, rep) in repaired
             if rep is not None
         ]
