@@ -129,8 +129,15 @@ def glued(p: np.ndarray, turn: float | None) -> np.ndarray:
     if turn is None:
         return p
     a = np.arctan2(p[:, 1], p[:, 0]) % (2 * np.pi)
-    half = np.pi - 0.5 * turn
+    half = glue_reach(turn)
     return np.vstack([p, rotate(p[a < half], turn), rotate(p[turn - a < half], -turn)])
+
+
+def glue_reach(turn: float) -> float:
+    """How far (an angle) from a glued side of a development of angle
+    ``turn`` its samples are imaged across the other: half the wedge outside
+    the sector, so that the two sides' images do not overlap (:func:`glued`)."""
+    return np.pi - 0.5 * turn
 
 
 class _Problem:
@@ -212,7 +219,7 @@ class _Problem:
         out, of, angle = [], [], []
         # within half the wedge outside the sector too, so that the images
         # round the apex do not overlap one another nor the sector (:func:`glued`)
-        half = np.pi - 0.5 * self.turn
+        half = glue_reach(self.turn)
         side = ((1.0, a), (-1.0, self.turn - a))
         for sign, near in ((sg, (off * r < band) & (off < half)) for sg, off in side):
             out.append(rotate(p[near], sign * self.turn))

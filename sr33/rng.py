@@ -13,10 +13,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from . import _kernels
 from ._validate import as_points, check_k, check_not_degenerate, check_unique
+from .neighbours import tied_neighbours
 from .progress import bar, chunks
 from .threads import thread_map
 from .tolerance import DEFAULT, Tolerance
@@ -78,21 +78,8 @@ def k_neighbourhoods(points, k: int, *, tolerance: Tolerance = DEFAULT) -> Neigh
     """
     pts = as_points(points)
     k = check_k(k, pts.shape[0])
-    n = pts.shape[0]
-    tree = cKDTree(pts)
-    q = min(n, k + 1 + 16)
-    while True:
-        dist, idx = tree.query(pts, q)
-        limit = dist[:, k] * (1.0 + tolerance.rtol)
-        keep = dist <= limit[:, None]
-        if q == n or not keep[:, -1].any():
-            break
-        q = min(n, 2 * q)
-    # samples are distinct, so u (distance 0) is always the first column.
-    counts = keep.sum(axis=1)
-    indptr = np.zeros(n + 1, dtype=np.int64)
-    np.cumsum(counts, out=indptr[1:])
-    indices = idx[keep].astype(np.int64)
+    # samples are distinct, so u (distance 0) is always the first of its row.
+    _, indptr, indices = tied_neighbours(pts, k, tolerance.rtol)
     return Neighbourhoods(indptr=indptr, indices=indices)
 
 

@@ -38,9 +38,16 @@ FOLDERS = {
     "gui": "sr33.gui",
 }
 
-# the low layer: mesh primitives (and their numba kernels), progress bars and
-# step timing
-BASE = {"sr33.mesh", "sr33.progress", "sr33._intersect", "sr33._edges", "sr33.jit"}
+# the low layer: mesh primitives (and their numba kernels), neighbours with
+# their ties, progress bars and step timing
+BASE = {
+    "sr33.mesh",
+    "sr33.neighbours",
+    "sr33.progress",
+    "sr33._intersect",
+    "sr33._edges",
+    "sr33.jit",
+}
 TOP = {"sr33", "sr33.cli"}  # the hub and the command line see everything
 
 ALLOWED = {

@@ -20,9 +20,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse import csr_matrix
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
 from sr33.mesh import SQRT3_2, as_mesh, edge_incidence, half_edges, triangle_ratios, unique_rows
+from sr33.neighbours import tied_neighbours
 
 OFF_TRUTH = 0.1  # h: farther from the truth, a sample is measured where it snaps, not where it is
 OFF_FRAME = 1.0  # h: a median this far off is another frame or unit, not a sampling
@@ -769,7 +771,9 @@ def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8, curvature
     return edges, cross, tri
 
 
-def neighbourhood_reach(points, dt_edges, edge_length, k: int = NEIGHBOURS) -> np.ndarray:
+def neighbourhood_reach(
+    points, dt_edges, edge_length, k: int = NEIGHBOURS, *, tree: cKDTree | None = None
+) -> np.ndarray:
     """Condition II-i, M_u ≅ D, as measured on the samples: how far along the
     surface each sample's neighbourhood N(u; k) reaches (Section 3.0.2).
 
@@ -805,7 +809,9 @@ def neighbourhood_reach(points, dt_edges, edge_length, k: int = NEIGHBOURS) -> n
         N(u; k)'s size: u, its k nearest samples and every sample tied with
         the k-th (within a relative ``TIE_RTOL``; the rule of
         :mod:`sr33.tolerance`, so that the answer does not depend on the
-        samples' order).
+        samples' order: :func:`sr33.neighbours.tied_neighbours`).
+    tree : cKDTree, optional
+        The samples' tree, when the caller has one.
 
     Returns
     -------
@@ -820,34 +826,20 @@ def neighbourhood_reach(points, dt_edges, edge_length, k: int = NEIGHBOURS) -> n
     k = min(int(k), n - 1)
     if k < 1:
         return np.zeros(n)
-    tree = cKDTree(pts)
-    q = min(n, k + 1 + 16)
-    while True:
-        dist, idx = tree.query(pts, q)
-        radius = dist[:, k]
-        keep = dist <= radius[:, None] * (1.0 + TIE_RTOL)
-        if q == n or not keep[:, -1].any():
-            break
-        q = min(n, 2 * q)
-    counts = keep.sum(axis=1)
-    ptr = np.zeros(n + 1, dtype=np.int64)
-    np.cumsum(counts, out=ptr[1:])
+    radius, ptr, members = tied_neighbours(pts, k, TIE_RTOL, tree)
     e = np.asarray(dt_edges, dtype=np.int64).reshape(-1, 2)
     w = np.asarray(edge_length, dtype=np.float64)
-    src = np.concatenate([e[:, 0], e[:, 1]])
-    order = np.argsort(src, kind="stable")
-    nbr = np.concatenate([e[:, 1], e[:, 0]])[order]
-    wts = np.concatenate([w, w])[order]
-    indptr = np.searchsorted(src[order], np.arange(n + 1)).astype(np.int64)
+    graph = csr_matrix((np.r_[w, w], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), (n, n))
     paths = bounded_paths(
-        indptr,
-        nbr,
-        wts,
+        graph.indptr.astype(np.int64),
+        graph.indices.astype(np.int64),
+        graph.data,
         np.arange(n, dtype=np.int64),
         REACH * radius,
         ptr,
-        idx[keep].astype(np.int64),
+        members,
     )
+    counts = np.diff(ptr)
     longest = np.zeros(n)
     np.maximum.at(longest, np.repeat(np.arange(n), counts), paths)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -969,7 +961,6 @@ def sample_conditions(
             ) from exc
     with timed("conditions: labels"):
         dt_edges, crossings, dt_tri, label = _labelled_delaunay(tv, tf, snap, pts, sharp_degrees)
-        curvature = _cell_curvature(tv, tf, label, snap, n)
         orphans = np.setdiff1d(np.arange(n), dt_tri)
         if orphans.size and dt_tri.size:
             dt_edges, crossings, dt_tri = _settle(
@@ -980,6 +971,7 @@ def sample_conditions(
         geodesics(dt_edges)  # every DT_M edge's length, in one pass
     if flip_ties:
         with timed("conditions: angle test"):
+            curvature = _cell_curvature(tv, tf, label, snap, n)
             dt_edges, crossings, dt_tri = _flip_to_delaunay(
                 pts, (dt_edges, crossings, dt_tri), geodesics, curvature=curvature
             )
@@ -1040,5 +1032,5 @@ def sample_conditions(
         epsilon=max(eps, 0.0) if np.isfinite(eps) else eps,
         smooth=smooth,
         truth_genus=genus,
-        reach=neighbourhood_reach(pts, dt_edges, length, k),
+        reach=neighbourhood_reach(pts, dt_edges, length, k, tree=tree),
     )
