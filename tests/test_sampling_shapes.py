@@ -755,6 +755,14 @@ def test_rings_round_a_pole_and_an_apex_are_repaired(sampled, checked):
         # 139 samples within reach, where rings halving anywhere left 150-odd)
         assert near.sum() > 100 and not bad[near].any()
     assert math.isfinite(rep.worst_ratio[on_axis].max())  # apex and pole in triangles
+    # the ball's pole was chosen judged with its rings POLE_ZONE steps past
+    # the repaired ones (stop 52), by the figure the geodesic check reads there
+    from sr33.samplers.layers import POLE_ZONE, ZONE_GOOD
+
+    assert rings["pole_zone_worst"] < ZONE_GOOD
+    ball = r.points[on_axis][np.argmin(r.points[on_axis, 2])]
+    zone = np.linalg.norm(r.points - ball, axis=1) < (rings["pole_reach"] + POLE_ZONE - 1) * h
+    assert abs(rep.worst_ratio[zone].max() - rings["pole_zone_worst"]) < 0.005
 
 
 @pytest.mark.parametrize("name", by_speed(["torus", "sphere", "cone_tip", "cone"]))
@@ -1362,3 +1370,41 @@ def test_the_apex_triangulation_is_the_cones_intrinsic_delaunay(degrees):
     interior = [i for i in range(1, r.size) if i not in boundary]
     assert len(interior) > 30
     np.testing.assert_allclose(round_vertex[interior], 2 * math.pi, atol=1e-9)
+
+
+def test_a_spheres_zone_is_judged_by_its_intrinsic_delaunay_triangles():
+    """:func:`sr33.samplers.layers._sphere_zone_worst` (the pole's rings
+    judged): on a sphere the intrinsic Delaunay triangles of samples are the
+    faces of their convex hull; the zone's figure is the worst ratio over
+    those faces without a corner on the zone's rim, exactly."""
+    import cadquery as cq
+    from scipy.spatial import ConvexHull, Delaunay
+
+    from sr33.mesh import triangle_ratios
+    from sr33.samplers.layers import _sphere_zone_worst
+
+    radius = 2.0
+    face = cq.Workplane().sphere(radius).faces().val()
+    rng = np.random.default_rng(7)
+    pole = np.array([0.0, 0.0, -radius])
+    # a cap of 35° round the pole: the pole and points at random
+    theta = np.arccos(1 - rng.random(300) * (1 - np.cos(np.radians(35))))
+    phi = rng.random(300) * 2 * np.pi
+    cap = radius * np.stack(
+        [np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), -np.cos(theta)], 1
+    )
+    pts = np.vstack([pole, cap])
+    hull = ConvexHull(pts)
+    # the faces towards the outside (the base's are the cap's rim joined)
+    outward = hull.equations[:, :3] @ np.array([0.0, 0.0, -1.0]) > 0.0
+    faces = hull.simplices[outward & (hull.equations[:, 3] < -0.5 * radius)]
+    # the zone's rim: the cap's points on the hull of their map
+    theta_all = np.r_[0.0, theta]
+    x = pts / radius
+    xy = np.stack([x[:, 0], x[:, 1]], 1) / (1.0 - x[:, 2])[:, None]
+    rim = np.zeros(pts.shape[0], dtype=bool)
+    rim[np.unique(Delaunay(xy).convex_hull)] = True
+    faces = faces[~rim[faces].any(axis=1)]
+    assert faces.shape[0] > 300 and theta_all[rim].min() > np.radians(20)
+    expected = triangle_ratios(pts, faces).max()
+    assert _sphere_zone_worst(pts, face, pole) == pytest.approx(expected, abs=1e-12)
