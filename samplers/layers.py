@@ -959,9 +959,11 @@ def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) ->
     return float(np.r_[triangle_ratios(uv, tri[judged]), 0.0].max())
 
 
-def _apex_triangulation(rho, ang, rim_ang, slant: float, sin_a: float, t: float):
+def _apex_triangulation(
+    rho, ang, rim_ang, slant: float, sin_a: float, t: float, zone: float | None = None
+):
     """The intrinsic Delaunay triangulation of a cone's samples within
-    ``APEX_JUDGED_FROM + 3`` t of its apex (the apex sample 0), for
+    ``zone`` t of its apex (default ``APEX_JUDGED_FROM + 3``; the apex sample 0), for
     :func:`_apex_worst`: their slant distances, the triangles (sample
     triples, counter-clockwise on the cone), the lengths on the cone of
     their sides (side q from corner q to corner q + 1) and the number of
@@ -971,8 +973,8 @@ def _apex_triangulation(rho, ang, rim_ang, slant: float, sin_a: float, t: float)
     theta = 2 * math.pi * sin_a
     r = np.r_[0.0, rho, np.full(len(rim_ang), slant)]
     psi = np.r_[0.0, np.asarray(ang) * sin_a, np.asarray(rim_ang) * sin_a] % theta
-    zone = r < (APEX_JUDGED_FROM + 3.0) * t
-    r, psi = r[zone], psi[zone]
+    near = r < (APEX_JUDGED_FROM + 3.0 if zone is None else zone) * t
+    r, psi = r[near], psi[near]
     if r.size < 4:
         return r, np.empty((0, 3), np.int64), np.empty((0, 3)), 0
     phi = psi * (2 * math.pi / theta)
@@ -1045,14 +1047,25 @@ def _apex_triangulation(rho, ang, rim_ang, slant: float, sin_a: float, t: float)
     return r, np.array(corners, dtype=np.int64), lengths, flips
 
 
-def _apex_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) -> float:
+def _apex_worst(
+    rho,
+    ang,
+    rim_ang,
+    slant: float,
+    sin_a: float,
+    t: float,
+    judged: float | None = None,
+    zone: float | None = None,
+) -> float:
     """The worst Condition III-ii ratio of the intrinsic Delaunay triangles
-    round a cone's apex (centroid within ``APEX_JUDGED_FROM`` t of it), the
-    apex a sample: what :func:`_developed_worst` leaves out.
+    round a cone's apex (centroid within ``judged`` t of it, by default
+    ``APEX_JUDGED_FROM``), the apex a sample: what :func:`_developed_worst`
+    leaves out.
 
     No planar picture of a cone holds its Delaunay triangles round the apex
     (a circle there may take in the apex, and the cone's disk then wraps
-    round it).  So the samples within ``APEX_JUDGED_FROM + 3`` t of the apex
+    round it).  So the samples within ``zone`` t of the apex (by default
+    ``APEX_JUDGED_FROM + 3``)
     are triangulated on the development opened out to a whole turn (angles
     times 2π / its angle: a picture of the cone round its apex, not an
     isometric one), every edge given its length on the cone (the chord
@@ -1063,11 +1076,12 @@ def _apex_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) -> floa
     there (0.911 before its development was glued without overlap) that no
     planar picture shows.
     """
-    r, tris, lengths, _ = _apex_triangulation(rho, ang, rim_ang, slant, sin_a, t)
-    judged = r[tris].mean(axis=1) < APEX_JUDGED_FROM * t if tris.size else np.empty(0, bool)
-    if not judged.any():
+    r, tris, lengths, _ = _apex_triangulation(rho, ang, rim_ang, slant, sin_a, t, zone)
+    judged = APEX_JUDGED_FROM if judged is None else judged
+    inner = r[tris].mean(axis=1) < judged * t if tris.size else np.empty(0, bool)
+    if not inner.any():
         return 0.0
-    sides = np.sort(lengths[judged], axis=1)
+    sides = np.sort(lengths[inner], axis=1)
     return float((sides[:, 1] / sides[:, 2]).max())
 
 
@@ -1838,13 +1852,31 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
             for end in (0, 1):
                 part = parts[0] if end == 0 else parts[-1]
                 face = faces[part[0]]
-                if face.geomType() != "SPHERE":
-                    continue
                 near = made[3] if end == 0 else total - made[3]
-                zone = near <= (reach + POLE_ZONE) * t + 1e-9 * t
                 pole = o + (part[2][0] if end == 0 else part[2][-1]) * axis
-                # the pole's own sample (on the axis, kept) among them
-                zones.append(_sphere_zone_worst(np.vstack([pole, made[0][zone]]), face, pole))
+                if face.geomType() == "SPHERE":
+                    zone = near <= (reach + POLE_ZONE) * t + 1e-9 * t
+                    # the pole's own sample (on the axis, kept) among them
+                    zones.append(_sphere_zone_worst(np.vstack([pole, made[0][zone]]), face, pole))
+                elif face.geomType() == "CONE":
+                    # the cone's own samples round its apex, by their intrinsic
+                    # Delaunay triangles (the apex a sample, :func:`_apex_worst`)
+                    mine = (made[2] == part[0]) & (near <= (reach + POLE_ZONE + 1) * t)
+                    q = made[0][mine] - o
+                    ang = np.arctan2(dot(q, ey), dot(q, ex)) % (2 * math.pi)
+                    sin_a = math.sin(abs(basis_surface(face).Cone().SemiAngle()))
+                    zones.append(
+                        _apex_worst(
+                            near[mine],
+                            ang,
+                            [],
+                            0.0,
+                            sin_a,
+                            t,
+                            judged=reach + POLE_ZONE - 1,
+                            zone=reach + POLE_ZONE + 1,
+                        )
+                    )
         worst = (max(left, default=0.0), max(zones, default=0.0))
         return ring, ring_at, columns, repaired, worst
 

@@ -1408,3 +1408,29 @@ def test_a_spheres_zone_is_judged_by_its_intrinsic_delaunay_triangles():
     assert faces.shape[0] > 300 and theta_all[rim].min() > np.radians(20)
     expected = triangle_ratios(pts, faces).max()
     assert _sphere_zone_worst(pts, face, pole) == pytest.approx(expected, abs=1e-12)
+
+
+@pytest.mark.slow
+def test_a_blunt_cone_tips_rings_past_its_apex_repair_are_judged():
+    """A cone tip off the library's defaults (ball 0.4, apex 0.6 above its
+    centre: a 240° development): its apex's repair with a reach of 8 ended
+    at 0.83, and nothing judged the rings just past it, where 59 samples
+    9-10 t from the apex broke the 0.85 margin (0.876).  The revolved
+    body's choice of reach now judges the cone's rings POLE_ZONE steps past
+    the repaired ones by their intrinsic Delaunay triangles (stop 52), by
+    the figure the geodesic check reads there."""
+    from sr33.samplers.layers import POLE_ZONE, ZONE_GOOD
+    from sr33.validators.conditions import sample_conditions
+
+    s = shapes.build("cone_tip", radius=0.4, apex_height=0.6)
+    r = scan(s)
+    (rings,) = [x for x in r.meta["repairs"] if x["kind"] == "revolved rings"]
+    assert rings["pole_zone_worst"] < ZONE_GOOD
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    assert rep.worst_ratio.max() < 0.85
+    h = r.meta["spacing"]
+    # the figure is the worse of the two ends' (the apex's and the ball's pole's)
+    reach = (rings["pole_reach"] + POLE_ZONE - 1) * h
+    ends = [np.array([0.0, 0.0, 0.6]), np.array([0.0, 0.0, -0.4])]
+    zone = np.any([np.linalg.norm(r.points - e, axis=1) < reach for e in ends], axis=0)
+    assert abs(rep.worst_ratio[zone].max() - rings["pole_zone_worst"]) < 0.005
