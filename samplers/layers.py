@@ -1648,7 +1648,8 @@ def _repair_pole(
     return inner, list(zip(r2.tolist(), a2.tolist())), row2.tolist(), report
 
 
-#: a sphere's pole is judged with its rings this many steps t past the repaired ones
+#: a revolved body's pole (a sphere's, a cone's apex) is judged with its rings
+#: this many steps t past the repaired ones
 POLE_ZONE = 5
 #: ... and passes below this (its figure is the geodesic check's: cone_tip's
 #: ball 0.8441 where the check reads 0.8449; the margin 0.85 less 0.005)
@@ -1662,7 +1663,8 @@ def _sphere_zone_worst(pts: np.ndarray, face, pole: np.ndarray) -> float:
     On a sphere the intrinsic Delaunay triangles are those of the samples'
     stereographic map from the antipode (it takes the sphere's circles to
     the plane's, their insides to insides); each triangle's ratio is taken
-    from its chords (within 1e-4 of its arcs' at the rings' steps).  The
+    from its chords (an arc l long is a chord shorter by a part (l/R)²/24
+    of it, so the ratios differ by less than that).  The
     triangles of the zone's outer ring, whose circles may take in samples
     beyond it, are left out: those with a corner on the convex hull.
     """
@@ -1711,10 +1713,11 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     a reach of steps of a pole the rings are one step apart, end their
     crowded columns as on a cone (:func:`lattice_cone_faces`) and are
     repaired (:func:`_repair_pole`); the reach is the first of
-    ``POLE_REACHES`` whose repairs end below ``POLE_GOOD`` and whose
-    spheres' poles, with their rings ``POLE_ZONE`` steps further, below
-    ``ZONE_GOOD`` (:func:`_sphere_zone_worst`; else the best), and the
-    report says which (``pole_reach``, ``pole_zone_worst``).  Samples on the axis (the apex, the
+    ``POLE_REACHES`` whose repairs end below ``POLE_GOOD`` and whose poles,
+    with their rings ``POLE_ZONE`` steps further, below ``ZONE_GOOD`` by
+    their intrinsic Delaunay triangles (a sphere's :func:`_sphere_zone_worst`,
+    a cone apex's :func:`_apex_worst`; else the best), and the report says
+    which (``pole_reach``, ``pole_zone_worst``).  Samples on the axis (the apex, the
     poles) stay; every other sample of the body is replaced (the seam's
     vertices are not features of the surface).  Each ring sample is the
     exact meridian point turned about the axis, so it lies on the surface.
@@ -1808,12 +1811,15 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     def layout(reach: int):
         """Rings, their columns and the poles' repairs with ``reach`` rows
         round each pole; and the worst ratios the layout was left with
-        round its poles: the repairs' own, and that of a sphere's rings
-        within ``reach + POLE_ZONE`` t of its pole (:func:`_sphere_zone_worst`:
-        the rings just past the repaired ones halve and end their columns
-        by rules that meet there, and nothing judged them; cone_tip's ball
+        round its poles: the repairs' own, and that of the pole's rings
+        within ``reach + POLE_ZONE`` t of it, a sphere's by
+        :func:`_sphere_zone_worst`, a cone apex's by :func:`_apex_worst`
+        (the rings just past the repaired ones halve and end their columns
+        by rules that meet there, and nothing judged them: cone_tip's ball
         laid out with a reach of 8 had 136 samples of its rings 9 to 11 t
-        from the pole violating III-ii, while its repairs ended at 0.82)."""
+        from the pole violating III-ii, while its repairs ended at 0.82; a
+        cone tip with a ball of 0.4 and its apex 0.6 above, a reach of 8,
+        59 samples 9-10 t from the apex at 0.876)."""
         plan = ring_positions(
             mer_s, mer_r, t, m, closed=closed, keep=(0, 0) if closed else (reach, reach)
         )
@@ -1882,7 +1888,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
 
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     # the poles' repairs are a local search whose end depends on its input:
-    # the first reach whose repairs end below POLE_GOOD and whose spheres'
+    # the first reach whose repairs end below POLE_GOOD and whose poles'
     # zones below ZONE_GOOD, else the best
     reach, (ring, ring_at, columns, repaired, (_, zone_worst)) = _first_passing(
         POLE_REACHES if not closed else (POLE_REACH,),
