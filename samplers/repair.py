@@ -65,6 +65,7 @@ IMAGE_BAND = 4.0  # samples this near (times h) a glued side of a development ge
 CORNER_DISTANCES = (0.7, 0.85, 1.0)  # a sample added on a corner's bisector this far, times h
 CORNER_ROUNDS = 4  # corners split one after another, at most this many
 CORNER_REACH = 4.0  # a split's repair moves the free samples this near (times h) the new one
+WATCH_GONE = 1.5  # ... and is judged on the samples this near (times h) free ones it removed
 GOOD_ENOUGH = 0.85  # further attempts (after a first one broke III-ii) end below this
 # ... and with at least this many triangles above the margin: a few in the
 # chart's judged frame are often no violation on the surface, and retrying
@@ -815,10 +816,18 @@ def split_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
                 continue
             grown, of = np.vstack([out.uv, new]), np.r_[was, n]
             near = np.linalg.norm(grown - new, axis=1) < CORNER_REACH * h
-            trial = repair(grown, near & _flags(free, of, True), h, **_roles(of, near), **kwargs)
-            # judged like ``first``: every free sample's triangles
+            movable = near & _flags(free, of, True)
+            trial = repair(grown, movable, h, **_roles(of, near), **kwargs)
+            # judged like ``first``: every free sample's triangles, and those
+            # where the trial removed free samples (a trial that removed them
+            # all was judged on no triangle, worst 0: a cutcube with a scoop
+            # of 0.35 kept a hole on two faces, 40 samples at 1.0 each)
             src = np.r_[of, n][np.where(trial.origin >= 0, trial.origin, of.size)]
-            judged = repair(trial.uv, _flags(free, src, True), h, **_roles(src), **fixed_kw)
+            watch = _flags(free, src, True)
+            gone = np.setdiff1d(np.flatnonzero(movable), trial.origin[trial.origin >= 0])
+            if gone.size:
+                watch |= cKDTree(grown[gone]).query(trial.uv)[0] < WATCH_GONE * h
+            judged = repair(trial.uv, watch, h, **_roles(src), **fixed_kw)
             if best is None or (judged.worst, judged.bad) < (best[0].worst, best[0].bad):
                 best = (judged, trial)
         if best is None or best[0].worst >= out.worst:

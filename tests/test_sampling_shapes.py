@@ -1434,3 +1434,25 @@ def test_a_blunt_cone_tips_rings_past_its_apex_repair_are_judged():
     ends = [np.array([0.0, 0.0, 0.6]), np.array([0.0, 0.0, -0.4])]
     zone = np.any([np.linalg.norm(r.points - e, axis=1) < reach for e in ends], axis=0)
     assert abs(rep.worst_ratio[zone].max() - rings["pole_zone_worst"]) < 0.005
+
+
+@pytest.mark.slow
+def test_a_faces_repair_report_does_not_hide_a_broken_face():
+    """A cutcube whose scoop (0.35) nearly meets its hole (0.3): the corner
+    splits of its scooped sides (``repair.split_corners``) tried a repair
+    that removed every free sample, judged it on no triangle (worst 0) and
+    kept it, so the faces were reported clean while 40 of their samples
+    each broke Condition III-ii at 1.0.  A trial is now judged where it
+    removed free samples too: no planar face whose samples break III-ii
+    (0.9 or more by the geodesic check) is reported within the margin."""
+    from sr33.validators.conditions import sample_conditions
+
+    s = shapes.build("cutcube", hole_radius=0.3, scoop_radius=0.35)
+    r = scan(s)
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    planes = [x for x in r.meta["repairs"] if x["kind"] == "plane"]
+    assert planes
+    for x in planes:
+        on = r.face_id == x["face"]
+        if rep.worst_ratio[on].max() >= 0.9:
+            assert x["worst"] >= 0.85 and x["bad"] > 0, x
