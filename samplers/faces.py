@@ -139,6 +139,33 @@ def perpendicular(v: np.ndarray) -> np.ndarray:
     return u / norm(u)
 
 
+class Stereographic:
+    """The stereographic projection of a sphere from the point opposite
+    ``pole`` (a unit vector from the centre), scaled to be isometric at the
+    pole: a point at angle θ from it maps to ``2 R tan(θ / 2)``.  It takes
+    the sphere's circles to the plane's (their insides to insides), so the
+    map's Delaunay triangles are the sphere's intrinsic ones."""
+
+    def __init__(self, centre: np.ndarray, radius: float, pole: np.ndarray):
+        self.centre, self.radius, self.pole = centre, radius, pole
+        self.e1 = perpendicular(pole)
+        self.e2 = np.cross(pole, self.e1)
+
+    def __call__(self, p) -> np.ndarray:
+        u = (np.asarray(p, dtype=np.float64) - self.centre) / self.radius
+        den = 1.0 + dot(u, self.pole)
+        uv = np.stack([dot(u, self.e1), dot(u, self.e2)], axis=1)
+        return 2.0 * self.radius * uv / den[:, None]
+
+    def inverse(self, q: np.ndarray) -> np.ndarray:
+        x = q / (2.0 * self.radius)
+        s2 = (x**2).sum(axis=1)
+        u = (
+            2.0 * x[:, :1] * self.e1 + 2.0 * x[:, 1:] * self.e2 + (1.0 - s2)[:, None] * self.pole
+        ) / (1.0 + s2)[:, None]
+        return self.centre + self.radius * u
+
+
 def goes_round(face) -> bool:
     """Whether a face of revolution goes all the way round its axis."""
     umin, umax, _, _ = face._uvBounds()

@@ -42,6 +42,7 @@ from .chart import (
 )
 from .disks import HALVE_GAP
 from .faces import (
+    Stereographic,
     basis_surface,
     boundary_segments,
     cap_rim,
@@ -1661,25 +1662,19 @@ def _sphere_zone_worst(pts: np.ndarray, face, pole: np.ndarray) -> float:
     a sphere's samples ``pts`` round its ``pole`` (a cap of the sphere ``face``).
 
     On a sphere the intrinsic Delaunay triangles are those of the samples'
-    stereographic map from the antipode (it takes the sphere's circles to
-    the plane's, their insides to insides); each triangle's ratio is taken
-    from its chords (an arc l long is a chord shorter by a part (l/R)²/24
-    of it, so the ratios differ by less than that).  The
-    triangles of the zone's outer ring, whose circles may take in samples
-    beyond it, are left out: those with a corner on the convex hull.
+    stereographic map from the antipode
+    (:class:`~sr33.samplers.faces.Stereographic`); each triangle's ratio is
+    taken from its chords (an arc l long is a chord shorter by a part
+    (l/R)²/24 of it, so the ratios differ by less than that).  The triangles
+    of the zone's outer ring, whose circles may take in samples beyond it,
+    are left out: those with a corner on the convex hull.
     """
     if pts.shape[0] < 4:
         return 0.0
     sph = basis_surface(face).Sphere()
     centre = np.array(sph.Location().Coord())
-    radius = float(sph.Radius())
-    n = (pole - centre) / norm(pole - centre)
-    e1 = perpendicular(n)
-    e2 = np.cross(n, e1)
-    u = (pts - centre) / radius
-    den = 1.0 + u @ n
-    xy = np.stack([u @ e1, u @ e2], axis=1) / den[:, None]
-    d = Delaunay(xy)
+    to2d = Stereographic(centre, float(sph.Radius()), (pole - centre) / norm(pole - centre))
+    d = Delaunay(to2d(pts))
     hull = np.zeros(pts.shape[0], dtype=bool)
     hull[np.unique(d.convex_hull)] = True
     tri = d.simplices[~hull[d.simplices].any(axis=1)]
@@ -1809,9 +1804,9 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         )
 
     def layout(reach: int):
-        """Rings, their columns and the poles' repairs with ``reach`` rows
-        round each pole; and the worst ratios the layout was left with
-        round its poles: the repairs' own, and that of the pole's rings
+        """The samples of the layout with ``reach`` rows repaired round
+        each pole (``points``), its number of rings, and the worst ratios it
+        was left with round its poles: the repairs' own, and that of the pole's rings
         within ``reach + POLE_ZONE`` t of it, a sphere's by
         :func:`_sphere_zone_worst`, a cone apex's by :func:`_apex_worst`
         (the rings just past the repaired ones halve and end their columns
@@ -1852,9 +1847,9 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
             for _, (_, _, _, rep) in repaired
             if rep is not None
         ]
+        made = points(ring, ring_at, columns, repaired)
         zones = []
         if not closed:
-            made = points(ring, ring_at, columns, repaired)
             for end in (0, 1):
                 part = parts[0] if end == 0 else parts[-1]
                 face = faces[part[0]]
@@ -1883,20 +1878,19 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
                             zone=reach + POLE_ZONE + 1,
                         )
                     )
-        worst = (max(left, default=0.0), max(zones, default=0.0))
-        return ring, ring_at, columns, repaired, worst
+        return made, len(ring), (max(left, default=0.0), max(zones, default=0.0))
 
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     # the poles' repairs are a local search whose end depends on its input:
     # the first reach whose repairs end below POLE_GOOD and whose poles'
     # zones below ZONE_GOOD, else the best
-    reach, (ring, ring_at, columns, repaired, (_, zone_worst)) = _first_passing(
+    reach, (made, rows, (_, zone_worst)) = _first_passing(
         POLE_REACHES if not closed else (POLE_REACH,),
         layout,
         lambda x: x[-1][0] < POLE_GOOD and x[-1][1] < ZONE_GOOD,
         lambda x: round(max(x[-1]), 6),
     )
-    new, ids, fids, _, reports = points(ring, ring_at, columns, repaired)
+    new, ids, fids, _, reports = made
     s.replace(
         np.flatnonzero(off_axis),  # all but the apex and poles (seam vertices too)
         new,
@@ -1907,7 +1901,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     return [
         {
             "kind": "revolved rings",
-            "rows": len(ring),
+            "rows": rows,
             "columns": m,
             "samples": len(new),
             "pole_reach": reach,

@@ -27,7 +27,13 @@ import numpy as np
 from sr33.mesh import dot, norm
 
 from .chart import Arc, Raster, arc_clamp, arc_sides, segment_distance
-from .faces import basis_surface, boundary_segments, goes_round, perpendicular, rims_sampled
+from .faces import (
+    Stereographic,
+    basis_surface,
+    boundary_segments,
+    goes_round,
+    rims_sampled,
+)
 from .layers import POLE_GOOD, RASTER, unstuck
 from .repair import repair
 from .samples import Samples
@@ -35,31 +41,6 @@ from .samples import Samples
 FRAME_REACH = 2.5  # the neighbours' samples this near a rim (times h) frame the repair
 MAP_GOOD = POLE_GOOD  # a repair ending at or above this on the map is tried again
 FACING = 0.2  # the face lies where the direction from the centre has cos > this with the pole
-
-
-class _Stereographic:
-    """The stereographic projection of a sphere from the point opposite
-    ``pole`` (a unit vector from the centre), scaled to be isometric at the
-    pole: a point at angle θ from it maps to ``2 R tan(θ / 2)``."""
-
-    def __init__(self, centre: np.ndarray, radius: float, pole: np.ndarray):
-        self.centre, self.radius, self.pole = centre, radius, pole
-        self.e1 = perpendicular(pole)
-        self.e2 = np.cross(pole, self.e1)
-
-    def __call__(self, p) -> np.ndarray:
-        u = (np.asarray(p, dtype=np.float64) - self.centre) / self.radius
-        den = 1.0 + dot(u, self.pole)
-        uv = np.stack([dot(u, self.e1), dot(u, self.e2)], axis=1)
-        return 2.0 * self.radius * uv / den[:, None]
-
-    def inverse(self, q: np.ndarray) -> np.ndarray:
-        x = q / (2.0 * self.radius)
-        s2 = (x**2).sum(axis=1)
-        u = (
-            2.0 * x[:, :1] * self.e1 + 2.0 * x[:, 1:] * self.e2 + (1.0 - s2)[:, None] * self.pole
-        ) / (1.0 + s2)[:, None]
-        return self.centre + self.radius * u
 
 
 def _circle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, float] | None:
@@ -99,7 +80,7 @@ def _rim_arcs(face, to2d) -> list[Arc] | None:
     return out
 
 
-def _rim_frame(face, arcs, sides, to2d: _Stereographic, s: Samples, own, h: float):
+def _rim_frame(face, arcs, sides, to2d: Stereographic, s: Samples, own, h: float):
     """The samples of the faces across the rims, within ``FRAME_REACH`` h of
     a rim, unfolded into the map: each at its distance from the rim (times
     the map's scale there), straight out from its nearest rim point.  Their
@@ -207,7 +188,7 @@ def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=N
     reach = dot(np.array([v.toTuple() for v in verts]) - centre, pole)
     if reach.min() <= FACING * radius:
         return None  # the face wraps too far round for one map
-    to2d = _Stereographic(centre, radius, pole)
+    to2d = Stereographic(centre, radius, pole)
     arcs = _rim_arcs(face, to2d)
     if arcs is None:
         return None

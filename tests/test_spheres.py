@@ -5,8 +5,9 @@ import math
 import numpy as np
 import pytest
 
+from sr33.samplers.faces import Stereographic
 from sr33.samplers.scanline import _plane_offsets
-from sr33.samplers.spheres import _circle, _Stereographic
+from sr33.samplers.spheres import _circle
 
 
 def _sphere_points(n, centre, radius, pole, reach, seed=0):
@@ -25,7 +26,7 @@ def test_stereographic_map_inverts_and_keeps_ratios():
     within a few parts in a thousand (the map is conformal)."""
     centre, radius = np.array([0.6, 0.6, 0.6]), 0.45
     pole = -np.ones(3) / math.sqrt(3)
-    m = _Stereographic(centre, radius, pole)
+    m = Stereographic(centre, radius, pole)
     p = _sphere_points(200, centre, radius, pole, math.radians(40))
     q = m(p)
     np.testing.assert_allclose(m.inverse(q), p, atol=1e-12)
@@ -35,7 +36,7 @@ def test_stereographic_map_inverts_and_keeps_ratios():
     )
     # a right triangle of legs 0.03 and 0.025 on the sphere, 30° from the pole
     a = centre + radius * np.array([math.sin(0.5), 0.0, math.cos(0.5)])
-    frame = _Stereographic(centre, radius, np.array([0.0, 0.0, 1.0]))
+    frame = Stereographic(centre, radius, np.array([0.0, 0.0, 1.0]))
     t1 = np.array([math.cos(0.5), 0.0, -math.sin(0.5)])
     t2 = np.array([0.0, 1.0, 0.0])
 
