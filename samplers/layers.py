@@ -168,6 +168,49 @@ def _ghosts(arcs: list[Arc], sides: list[float], h: float):
     return ghosts
 
 
+def _band_arcs(nbrs, to2d, raster, arcs: list[Arc], s: Samples, h: float, unfold):
+    """Which of a planar face's arcs (:func:`_arcs`, in its edges' order)
+    bound a face in ``unfold`` (a chain of developable faces laid out
+    already, :mod:`sr33.samplers.bands`), and that face's samples within
+    ``LAYER`` h of those arcs unfolded into the face's plane: each at its
+    distance from its foot on the circle, straight out from the foot.  They
+    are the repair's judged frame there, in place of the ghost rows (a
+    chamfer's cone round a filleted corner: the ghosts stood where its rows
+    did not, and a triangle of two of its samples and one the top's repair
+    added 0.25 h inside the arc broke III-ii at 0.87)."""
+    flags, frames = [], [np.empty((0, 2))]
+    k = 0
+    for e, fb in nbrs:
+        if e.geomType() != "CIRCLE":
+            continue
+        on = fb >= 0 and fb in unfold
+        flags.append(on)
+        if on:
+            circ = e._geomAdaptor().Circle()
+            c3 = np.array(circ.Location().Coord())
+            n3 = np.array(circ.Axis().Direction().Coord())
+            r = float(circ.Radius())
+            sel = np.flatnonzero(s.face_id == fb)
+            q = s.points[sel] - c3
+            radial = q - dot(q, n3)[:, None] * n3
+            rn = np.linalg.norm(radial, axis=1)
+            ok = rn > 1e-12
+            foot = c3 + r * radial[ok] / rn[ok, None]
+            dist = np.linalg.norm(s.points[sel][ok] - foot, axis=1)
+            a = arcs[k]
+            f2 = to2d(foot)
+            w = f2 - a.centre
+            ang = np.arctan2(w[:, 1], w[:, 0])
+            inside_arc = a.closed | ((ang - a.start) % (2 * math.pi) <= a.span)
+            near = (dist < LAYER * h) & (dist > 1e-6 * h) & inside_arc
+            w = w[near] / np.linalg.norm(w[near], axis=1)[:, None]
+            # outwards from the face: away from the centre where the face is inside
+            side = arc_sides([a], raster, h)[0]
+            frames.append(f2[near] + side * dist[near, None] * w)
+        k += 1
+    return flags, np.vstack(frames)
+
+
 def _line_ghosts(lines: list[_Line], h: float):
     """The neighbouring face unfolded across straight edges whose samples
     slide because that face's columns follow them (``follows``): its first
@@ -376,6 +419,40 @@ def _slanted_lines(
     return out
 
 
+#: a free sample of a planar face's repair keeps this far (times h) inside
+#: its straight edges that no slanted edge's clamp covers
+WALL_CLEAR = 0.25
+
+
+def _walls(face, to2d, raster, h: float, lines: list[_Line]) -> list[_Line]:
+    """The straight edges of a planar face not among ``lines`` (its slanted
+    ones), as :class:`_Line`'s with no frame: the repair's free samples
+    stay ``WALL_CLEAR`` h inside them too (:func:`_clamp_lines`).  Without
+    it a sample freed by an arc could cross an edge along the rows: a
+    hexagonal prism filleted on its vertical edges had a sample of its cap
+    0.2 h beyond a side."""
+    taken = [(ln.a, ln.b) for ln in lines]
+    n = np.array(face.normalAt().toTuple())
+    out = []
+    for e in face.Edges():
+        if e.geomType() != "LINE":
+            continue
+        a3 = np.array(e.startPoint().toTuple())
+        b3 = np.array(e.endPoint().toTuple())
+        a2, b2 = to2d(np.stack([a3, b3]))
+        if any(
+            min(norm(a2 - a) + norm(b2 - b), norm(a2 - b) + norm(b2 - a)) < 1e-9 * h
+            for a, b in taken
+        ):
+            continue
+        u = (b3 - a3) / norm(b3 - a3)
+        m = to2d((a3 + np.cross(n, u))[None])[0] - a2
+        if not raster(((a2 + b2) / 2 + 0.5 * h * m)[None])[0]:
+            m = -m
+        out.append(_Line(a2, b2, m, np.empty((0, 2)), False))
+    return out
+
+
 def _staggered(uv: np.ndarray, line: _Line, h: float) -> bool:
     """Whether the Delaunay triangles of a face's samples within ``LAYER`` h
     of a straight edge and of the neighbour's samples unfolded across it
@@ -405,8 +482,8 @@ def _chain(fns):
     return run
 
 
-def _clamp_lines(lines: list[_Line], h: float):
-    """Keep free samples at least 0.4 h inside every slanted edge."""
+def _clamp_lines(lines: list[_Line], h: float, margin: float = 0.4):
+    """Keep free samples at least ``margin`` h (by default 0.4) inside every edge of ``lines``."""
 
     edges = _Edges(lines)
     normals = np.array([ln.inward for ln in lines], dtype=np.float64).reshape(-1, 2)
@@ -420,9 +497,9 @@ def _clamp_lines(lines: list[_Line], h: float):
         t_all, in_all = measure(out)
         for k, ln in enumerate(lines):
             t, inward = t_all[:, k], in_all[:, k]
-            bad = (t > 0) & (t < 1) & (inward < 0.4 * h) & (inward > -2 * h)
+            bad = (t > 0) & (t < 1) & (inward < margin * h) & (inward > -2 * h)
             if bad.any():
-                out[bad] += (0.4 * h - inward[bad])[:, None] * ln.inward
+                out[bad] += (margin * h - inward[bad])[:, None] * ln.inward
                 t_all[bad], in_all[bad] = measure(out[bad])
         return out
 
@@ -453,6 +530,7 @@ def repair_planar_faces(
     again: int = AGAIN_ROUNDS,
     walls: dict[int, np.ndarray] | None = None,
     squares: bool = False,
+    unfold=frozenset(),
 ) -> list[dict]:
     """Repair the boundary layer of every planar face bounded by circular arcs
     or by straight sharp edges slanted to its scan rows.
@@ -567,7 +645,10 @@ def repair_planar_faces(
             continue
         near_follow = np.min(np.stack([far] + [ln.distance(uv) for ln in follow], axis=1), axis=1)
         anchors = at_corner & (near_follow < tol)
-        frame = np.vstack([np.empty((0, 2))] + [ln.frame for ln in lines if not ln.follows])
+        banded, arc_frame = _band_arcs(nbrs[fi], to2d, raster, arcs, s, h, unfold)
+        frame = np.vstack(
+            [np.empty((0, 2)), arc_frame] + [ln.frame for ln in lines if not ln.follows]
+        )
         # congruent faces (a prism's two ends) get one answer: their rims must agree
         key = (
             _congruence(uv, h),
@@ -610,15 +691,22 @@ def repair_planar_faces(
                     uv[cur[by_cur]] = rec[np.argsort(ang_rec, kind="stable")]
                     slide[cur] = False
             sides = arc_sides(arcs, raster, h)
-            clamps = ([arc_clamp(arcs, sides, h)] if arcs else []) + (
-                [_clamp_lines(lines, h)] if lines else []
+            walls_in = _walls(face, to2d, raster, h, lines)
+            clamps = (
+                ([arc_clamp(arcs, sides, h)] if arcs else [])
+                + ([_clamp_lines(lines, h)] if lines else [])
+                + ([_clamp_lines(walls_in, h, WALL_CLEAR)] if walls_in else [])
             )
             args = dict(
                 slide=slide,
                 project=_project_onto(arcs + lines, 0.3 * h) if arcs or lines else None,
                 inside=raster,
                 ghosts=_joined(
-                    ([_ghosts(arcs, sides, h)] if arcs else [])
+                    (
+                        [_ghosts(ghosted, [sd for sd, b in zip(sides, banded) if not b], h)]
+                        if (ghosted := [a for a, b in zip(arcs, banded) if not b])
+                        else []
+                    )
                     + ([_line_ghosts(follow, h)] if follow else [])
                 ),
                 anchors=anchors if anchors.any() else None,
@@ -672,7 +760,16 @@ def repair_planar_faces(
         redone = {
             x["face"]: x
             for x in repair_planar_faces(
-                occ, s, h, size, row_dirs, rest, again=again - 1, walls=walls, squares=squares
+                occ,
+                s,
+                h,
+                size,
+                row_dirs,
+                rest,
+                again=again - 1,
+                walls=walls,
+                squares=squares,
+                unfold=unfold,
             )
         }
         reports = [redone.get(x["face"], x) for x in reports]

@@ -75,6 +75,7 @@ from sr33.mesh import dot, norm, surface_points
 from sr33.progress import bar, log, timed
 
 from .adjacency import EdgeFaces
+from .bands import developable_bands
 from .faces import (
     basis_surface,
     exact_bounds,
@@ -825,7 +826,8 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
     per_edge: dict[int, tuple[list[np.ndarray], int]] = {}  # edge -> its samples, face
     dense: list[tuple[float, float, float]] = [tuple(p) for p in vertex_pts]
     lattices: dict[int, list[tuple[np.ndarray, np.ndarray, float]]] = {}
-    follows = _strip_followers(ef, FEATURE_CLEARANCE * step * 2, tol)
+    banded = {f for band in developable_bands(occ, tol / 1e-7) for f in band.faces}
+    follows = _strip_followers(ef, FEATURE_CLEARANCE * step * 2, tol, banded)
     polygonal = [_polygonal(f) for f in faces]
     # an edge following another across a strip is sampled after it
     order = [i for i in range(len(ef.edges)) if i not in follows] + sorted(follows)
@@ -855,10 +857,18 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
                 samples = _with_corners(lead, samples, [a, a + length * u], step)
                 per_edge[follows[ei]] = (samples, lead_face)
                 cross = _across_strip(a, u, length, lead, samples, step)
+            # an edge of a chain of developable faces takes the lattice of the
+            # face across it: the chain's layout joins whatever its loops hold
+            lattice_of = [k for k in fids if k not in banded] if len(fids) == 2 else fids
+            polys = polygonal
+            if len(lattice_of) < len(fids):
+                polys = [p or k in lattice_of for k, p in enumerate(polygonal)]
             if cross is None:
-                cross = _row_crossings(a, u, length, fids, faces, planes, step)
+                cross = _row_crossings(a, u, length, lattice_of, faces, planes, step)
             if cross is None:
-                cross = _square_crossings(a, u, length, fids, faces, polygonal, planes, axes, step)
+                cross = _square_crossings(
+                    a, u, length, lattice_of, faces, polys, planes, axes, step
+                )
             lattice = (a, u, length / m) if cross is None else (a + cross[2] * u, u, cross[1])
             for k in fids:
                 lattices.setdefault(k, []).append(lattice)
@@ -880,7 +890,7 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
     return pts, fid, np.array(dense, dtype=np.float64).reshape(-1, 3), lattices
 
 
-def _strip_followers(ef: EdgeFaces, width: float, tol: float) -> dict[int, int]:
+def _strip_followers(ef: EdgeFaces, width: float, tol: float, banded=()) -> dict[int, int]:
     """Straight edges that follow another across a narrow planar strip
     (edge index -> the edge it follows).
 
@@ -890,7 +900,13 @@ def _strip_followers(ef: EdgeFaces, width: float, tol: float) -> dict[int, int]:
     sampled each on its own lattice (the side's rows, the top's columns),
     half a step apart somewhere along it (ratio 1.0).  The shorter of two
     parallel straight edges of a strip follows the longer (the first on a
-    tie), unless that one follows another strip itself."""
+    tie), unless that one follows another strip itself.  A strip in a chain
+    of developable faces (``banded``: a chamfer round a filleted profile)
+    has no followers: the chain's layout joins its two edges' samples
+    whatever they are (:mod:`sr33.samplers.bands`), and each edge keeps the
+    lattice of the face across it (a chamfer on both ends of a filleted box
+    had each end's edge follow its chamfer's other edge, half a step off
+    the end's columns: 171 samples of each end at ratio 1.0)."""
     out: dict[int, int] = {}
     lines: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
     for ei, e in enumerate(ef.edges):
@@ -904,7 +920,7 @@ def _strip_followers(ef: EdgeFaces, width: float, tol: float) -> dict[int, int]:
             by_face.setdefault(k, []).append(ei)
     for k, mine in sorted(by_face.items()):
         face = ef.faces[k]
-        if face.geomType() != "PLANE" or len(mine) < 2:
+        if face.geomType() != "PLANE" or len(mine) < 2 or k in banded:
             continue
         corners = np.array([v.toTuple() for v in face.Vertices()]).reshape(-1, 3)
         for i, e1 in enumerate(mine):
@@ -1190,6 +1206,7 @@ def scan(
             on_feature = np.r_[on_feature, np.zeros(fill.shape[0], dtype=bool)]
         reports: list[dict] = []
         if repair:
+            from .bands import lattice_developable_bands
             from .disks import lattice_disk_faces
             from .fillets import lattice_filleted_box
             from .layers import (
@@ -1216,9 +1233,13 @@ def scan(
                 reports += more
                 laid |= done
                 pbar.update(1)
+            with timed("sample: developable bands"):
+                more, banded = lattice_developable_bands(occ, bag, h, size, skip=laid)
+            reports += more
+            laid |= banded
             with timed("sample: planar faces"):
                 reports += repair_planar_faces(
-                    occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=laid
+                    occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=laid, unfold=banded
                 )
             with timed("sample: planar faces along square edges"):
                 # then the faces bounded by edges along or across their rows
@@ -1231,6 +1252,7 @@ def scan(
                     row_dirs=[dirs[f] for f in fam],
                     skip=laid,
                     squares=True,
+                    unfold=banded,
                 )
             pbar.update(1)
             for step, lay in (
