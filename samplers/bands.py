@@ -589,11 +589,19 @@ def _lay(band: Band, s: Samples, t: np.ndarray, line: int, tol: float) -> dict:
 
 
 def lattice_developable_bands(
-    occ, s: Samples, h: float, size: float, skip=(), mend: bool = True
+    occ,
+    s: Samples,
+    h: float,
+    size: float,
+    skip=(),
+    mend: bool = True,
+    sharp_degrees: float = 20.0,
 ) -> tuple[list[dict], set[int]]:
     """Lay every chain of developable faces out as one lattice (the
     module's text), then repair it (:func:`repair_band`, unless not
-    ``mend``); returns a report per chain and the faces laid out.
+    ``mend``); returns a report per chain and the faces laid out.  Edges
+    whose faces' normals differ by less than ``sharp_degrees`` link faces
+    (the scan's own rule for the edges it does not sample).
 
     The samples off the features on the chain's faces are replaced; the
     samples on its two loops (and an open chain's end edges) stay, except
@@ -603,7 +611,7 @@ def lattice_developable_bands(
     tol = 1e-7 * size
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     reports, laid = [], set()
-    for band in developable_bands(occ, size, skip=skip):
+    for band in developable_bands(occ, size, sharp_degrees, skip=skip):
         widths = np.concatenate([st.ruling_lengths() for st in band.strips])
         rows = steps(float(np.median(widths)), h)
         t = np.arange(1, rows) / rows

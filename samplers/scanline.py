@@ -801,7 +801,9 @@ def _square_crossings(a, u, length, adjacent, faces, polygonal, planes, axes, st
     return None
 
 
-def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=None, axes=None):
+def _feature_samples(
+    occ, step: float, sharp_degrees: float, tol: float, planes=None, axes=None, banded=frozenset()
+):
     """Samples on B-rep vertices and on sharp or boundary edges.
 
     Returns the samples, their faces, a dense polyline of the sampled edges,
@@ -813,7 +815,9 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
     it slanted to an adjacent planar face's rows (:func:`_row_crossings`),
     or, between polygonal faces, along or across them off their lattice
     (:func:`_square_crossings`, with ``axes``: per face, the anchor and
-    steps of its rows along each axis, :func:`_face_columns`).  Samples are
+    steps of its rows along each axis, :func:`_face_columns`).  An edge
+    between a face of a chain of developable faces (``banded``,
+    :mod:`sr33.samplers.bands`) and another takes the other's lattice.  Samples are
     listed edge by edge in the shape's edge order, whatever order the edges
     were sampled in.
     """
@@ -826,7 +830,6 @@ def _feature_samples(occ, step: float, sharp_degrees: float, tol: float, planes=
     per_edge: dict[int, tuple[list[np.ndarray], int]] = {}  # edge -> its samples, face
     dense: list[tuple[float, float, float]] = [tuple(p) for p in vertex_pts]
     lattices: dict[int, list[tuple[np.ndarray, np.ndarray, float]]] = {}
-    banded = {f for band in developable_bands(occ, tol / 1e-7) for f in band.faces}
     follows = _strip_followers(ef, FEATURE_CLEARANCE * step * 2, tol, banded)
     polygonal = [_polygonal(f) for f in faces]
     # an edge following another across a strip is sampled after it
@@ -1119,7 +1122,7 @@ def scan(
             on_feature=res.on_feature,
             meta=meta,
         )
-    with bar(len(faces) + 2 + (9 if repair else 0), "sample", quiet, unit="step") as pbar:
+    with bar(len(faces) + 2 + (10 if repair else 0), "sample", quiet, unit="step") as pbar:
         lo, hi = exact_bounds(occ)
         size = float(norm(hi - lo))
         if area / (h * h * ratio) > 2_000_000:
@@ -1152,8 +1155,9 @@ def scan(
             t0, hf = aligned[fi]
             planes.append((d, t0, hf, _columns(face, d, hf, ratio, *columns[fi])))
         with timed("sample: feature samples"):
+            banded = {f for band in developable_bands(occ, size, sharp_degrees) for f in band.faces}
             pts, fids, feature_curve, lattices = _feature_samples(
-                occ, EDGE_STEP * h, sharp_degrees, tol, planes, columns
+                occ, EDGE_STEP * h, sharp_degrees, tol, planes, columns, banded
             )
         pbar.update(1)
         n_feature = len(pts)
@@ -1234,9 +1238,12 @@ def scan(
                 laid |= done
                 pbar.update(1)
             with timed("sample: developable bands"):
-                more, banded = lattice_developable_bands(occ, bag, h, size, skip=laid)
+                more, banded = lattice_developable_bands(
+                    occ, bag, h, size, skip=laid, sharp_degrees=sharp_degrees
+                )
             reports += more
             laid |= banded
+            pbar.update(1)
             with timed("sample: planar faces"):
                 reports += repair_planar_faces(
                     occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=laid, unfold=banded

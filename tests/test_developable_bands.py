@@ -139,9 +139,7 @@ def test_the_walls_of_a_filleted_prism_are_a_lattice_of_rows_and_columns():
         dy = np.maximum(np.abs(row[:, 1]) - 0.25, 0)
         assert np.abs(np.hypot(dx, dy) - 0.1).max() < 1e-9
         # ... with as many columns as the loops, about as far apart
-        assert min(loop.shape[0], top.shape[0]) <= row.shape[0] <= max(
-            loop.shape[0], top.shape[0]
-        )
+        assert min(loop.shape[0], top.shape[0]) <= row.shape[0] <= max(loop.shape[0], top.shape[0])
         g = gaps(row)
         assert lo - 1e-9 <= g.min() and g.max() <= 1.05 * hi
     n_rows = sum((np.abs(z - lv) < 1e-9).sum() for lv in levels)
