@@ -33,9 +33,19 @@ of their boundary samples (rectangles on the development) and a cone's
 rows shed their extra steps evenly from its wide run to its narrow one.
 Each row puts one sample on every smooth ruling it crosses; an open
 chain's end edges are sharp and sampled already, so their samples must
-stand on the rows (else the chain is left to the scan rows).  The planar
-faces of a chain are then left out of the planar faces' boundary-layer
-repair (:func:`sr33.samplers.layers.repair_planar_faces`).
+stand on the rows (else the chain is left to the scan rows).
+
+The lattice is then judged by Condition III-ii (Section 3 of the paper:
+every intrinsic Delaunay triangle's second-longest edge below √3/2 of its
+longest) strip by strip, on the development of the strip and its two
+neighbours (:class:`Window`; the development is an isometry, so its
+Delaunay triangles are the intrinsic ones), and repaired there where a
+triangle reaches the repair's margin (:func:`repair_band`,
+:func:`sr33.samplers.repair.repair`); the loop whose faces across are
+still to be laid out or repaired slides along its runs.  The planar faces
+of a chain are then left out of the planar faces' boundary-layer repair
+(:func:`sr33.samplers.layers.repair_planar_faces`), and a planar face
+across a chain's arc judges the chain's samples near it.
 
 CadQuery and OCP are imported when the functions run.
 """
@@ -512,6 +522,11 @@ def developable_bands(occ, size: float, sharp_degrees: float = 20.0, skip=()) ->
 
 
 def _walk(ef: EdgeFaces, links, by_face, first: int, closed: bool, tol: float) -> Band | None:
+    """The chain from face ``first`` (a closed one's lowest face, through its
+    link of higher index; an open one's end face, from its sharp end edge),
+    face after face across the links, loop A from the first ruling's start
+    point; None where a face is no quadrilateral of the strip or the walk
+    does not close (a Moebius band) or comes back early."""
     faces = ef.faces
     if closed:
         rin = ef.edges[min(by_face[first])]
