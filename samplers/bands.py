@@ -57,7 +57,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import Delaunay, cKDTree
+from scipy.spatial import Delaunay, QhullError, cKDTree
 
 from sr33.mesh import dot, norm, triangle_ratios
 
@@ -838,7 +838,10 @@ def repair_band(band: Band, s: Samples, h: float, tol: float, slide_sides=()) ->
         slid = np.concatenate(slid)
         ends = np.concatenate(ends)
         movable_src = ~s.on_feature[idx]
-        tri = Delaunay(xy).simplices
+        try:
+            tri = Delaunay(xy).simplices
+        except QhullError:
+            continue  # the window's samples are degenerate (on one line): nothing to judge
         cen = xy[tri].mean(axis=1)
         own = win.parts[win.own][0].contains(cen, 0.0, 1e-9) & win.inside(cen)
         broken = cen[own & (triangle_ratios(xy, tri) >= BAD)]
