@@ -117,7 +117,14 @@ class Strip:
         a = (th - self.theta0) * math.copysign(1.0, self.delta) % (2 * math.pi)
         return np.where(a > 0.5 * (abs(self.delta) + 2 * math.pi), a - 2 * math.pi, a)
 
-    def _cone(self) -> tuple[float, float, float]:
+    @functools.cached_property
+    def far_ruling(self) -> np.ndarray:
+        """The developed ends ``a1``, ``b1`` of the outgoing ruling (the
+        repair's clamps and inside tests ask at every step)."""
+        return self.local(np.vstack([self.a1, self.b1]))
+
+    @functools.cached_property
+    def cone(self) -> tuple[float, float, float]:
         """A cone's (slant distance of ``a0``, sin of its half angle, side of
         the apex along the ruling: +1 beyond ``b0``, -1 behind ``a0``)."""
         rho = float(norm(self.a0 - self.apex))
@@ -137,7 +144,7 @@ class Strip:
             return np.stack([dot(q, e2), dot(q, e1)], axis=1)
         if self.kind == "CYLINDER":
             return np.stack([self.run_a[1] * self.turn(pts), dot(pts - self.a0, e1)], axis=1)
-        rho0, sin_a, side = self._cone()
+        rho0, sin_a, side = self.cone
         rho = np.linalg.norm(pts - self.apex, axis=1)
         phi = self.turn(pts) * sin_a
         return np.stack([rho * np.sin(phi), side * (rho0 - rho * np.cos(phi))], axis=1)
@@ -158,7 +165,7 @@ class Strip:
             r = self.run_a[1]
             p = ring + r * (np.cos(th)[:, None] * self.ex + np.sin(th)[:, None] * self.ey)
             return p + xy[:, 1:] * e1
-        rho0, sin_a, side = self._cone()
+        rho0, sin_a, side = self.cone
         v = np.stack([xy[:, 0], rho0 - side * xy[:, 1]], axis=1)  # (rho sin phi, rho cos phi)
         rho = np.linalg.norm(v, axis=1)
         phi = np.arctan2(v[:, 0], v[:, 1])
@@ -176,7 +183,7 @@ class Strip:
         """Developed points (own frame) projected onto run ``side`` within
         its ends: (the points, their distances)."""
         if self.kind == "CONE":
-            rho0, sin_a, side_ = self._cone()
+            rho0, sin_a, side_ = self.cone
             rho = rho0 if side == "a" else float(norm(self.b0 - self.apex))
             v = np.stack([xy[:, 0], rho0 - side_ * xy[:, 1]], axis=1)
             phi = np.clip(np.arctan2(v[:, 0], v[:, 1]), 0.0, abs(self.delta) * sin_a)
@@ -195,7 +202,7 @@ class Strip:
         ``margin`` from both runs (the strip at least twice as wide)."""
         out = xy.copy()
         if self.kind == "CONE":
-            rho0, _, side = self._cone()
+            rho0, _, side = self.cone
             rho_b = float(norm(self.b0 - self.apex))
             v = np.stack([xy[:, 0], rho0 - side * xy[:, 1]], axis=1)
             rho = np.linalg.norm(v, axis=1)
@@ -203,7 +210,7 @@ class Strip:
             k = np.clip(rho, lo, hi) / np.maximum(rho, 1e-300)
             v = v * k[:, None]
             return np.stack([v[:, 0], (rho0 - v[:, 1]) * side], axis=1)
-        a1, b1 = self.local(np.vstack([self.a1, self.b1]))
+        a1, b1 = self.far_ruling
         top = np.array([0.0, float(norm(self.b0 - self.a0))])
         for p, q, sign in ((np.zeros(2), a1, 1.0), (top, b1, -1.0)):
             d = (q - p) / norm(q - p)
@@ -219,7 +226,7 @@ class Strip:
         rulings grown by ``pad``."""
         x, y = xy[:, 0], xy[:, 1]
         if self.kind == "CONE":
-            rho0, sin_a, side = self._cone()
+            rho0, sin_a, side = self.cone
             rho_b = float(norm(self.b0 - self.apex))
             vx, vy = x, rho0 - side * y
             rho = np.hypot(vx, vy)
@@ -227,7 +234,7 @@ class Strip:
             lo, hi = min(rho0, rho_b) - eps, max(rho0, rho_b) + eps
             span = abs(self.delta) * sin_a
             return (rho >= lo) & (rho <= hi) & (phi * rho >= -pad) & ((phi - span) * rho <= pad)
-        a1, b1 = self.local(np.vstack([self.a1, self.b1]))
+        a1, b1 = self.far_ruling
         w = float(norm(self.b0 - self.a0))
 
         def left(p, q):  # signed distance of the points left of the line p -> q
@@ -309,6 +316,7 @@ class Band:
     closed: bool
     ends: list[tuple[np.ndarray, np.ndarray]]
     across: dict[str, set[int]] = field(default_factory=dict)
+    width: float = 0.0  # the median length of its rulings
 
     @property
     def faces(self) -> list[int]:
@@ -465,9 +473,8 @@ def _opposite(face, link):
     return out[0] if len(out) == 1 and out[0].geomType() == "LINE" else None
 
 
-def developable_bands(occ, size: float, sharp_degrees: float = 20.0, skip=()) -> list[Band]:
-    """The chains of developable faces of ``occ`` (see the module's text),
-    leaving out any chain with a face in ``skip`` (laid out already).
+def developable_bands(occ, size: float, sharp_degrees: float = 20.0) -> list[Band]:
+    """The chains of developable faces of ``occ`` (see the module's text).
 
     Each chain is a path or a cycle of planes, cylinders and cones linked
     by smooth straight edges, every face a quadrilateral of the strip
@@ -497,7 +504,7 @@ def developable_bands(occ, size: float, sharp_degrees: float = 20.0, skip=()) ->
                         comp.add(g)
                         todo.append(g)
         seen |= comp
-        if comp & set(skip) or any(len(by_face[f]) > 2 for f in comp):
+        if any(len(by_face[f]) > 2 for f in comp):
             continue
         ones = sorted(f for f in comp if len(by_face[f]) == 1)
         closed = not ones
@@ -511,6 +518,7 @@ def developable_bands(occ, size: float, sharp_degrees: float = 20.0, skip=()) ->
         mid = float(np.median(widths))
         if mid < tol or float(np.abs(widths - mid).max()) > RULING_SPREAD * mid:
             continue
+        band.width = mid
         for side in ("a", "b"):
             band.across[side] = {
                 ef.other(e, st.face)
@@ -611,12 +619,15 @@ def lattice_developable_bands(
     skip=(),
     mend: bool = True,
     sharp_degrees: float = 20.0,
+    bands: list[Band] | None = None,
 ) -> tuple[list[dict], set[int]]:
     """Lay every chain of developable faces out as one lattice (the
     module's text), then repair it (:func:`repair_band`, unless not
     ``mend``); returns a report per chain and the faces laid out.  Edges
     whose faces' normals differ by less than ``sharp_degrees`` link faces
-    (the scan's own rule for the edges it does not sample).
+    (the scan's own rule for the edges it does not sample); ``bands``, the
+    chains :func:`developable_bands` found already (the scan finds them
+    before its feature samples), saves finding them again.
 
     The samples off the features on the chain's faces are replaced; the
     samples on its two loops (and an open chain's end edges) stay, except
@@ -626,9 +637,12 @@ def lattice_developable_bands(
     tol = 1e-7 * size
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     reports, laid = [], set()
-    for band in developable_bands(occ, size, sharp_degrees, skip=skip):
-        widths = np.concatenate([st.ruling_lengths() for st in band.strips])
-        rows = steps(float(np.median(widths)), h)
+    if bands is None:
+        bands = developable_bands(occ, size, sharp_degrees)
+    for band in bands:
+        if set(band.faces) & set(skip):
+            continue  # a face laid out already
+        rows = steps(band.width, h)
         t = np.arange(1, rows) / rows
         if not band.closed and not _ends_on_rows(band, s.points[s.on_feature], t, h, tol):
             continue
@@ -692,7 +706,7 @@ class Window:
         self.outer = []  # the window's outer rulings' ends, in the frame
         nxt = (k + 1) % n if band.closed else k + 1
         prv = (k - 1) % n if band.closed else k - 1
-        a1, b1 = st.local(np.vstack([st.a1, st.b1]))
+        a1, b1 = st.far_ruling
         if nxt < n and nxt != k:
             s2 = band.strips[nxt]
             r, p = _rigid(a1, (b1 - a1) / norm(b1 - a1))

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from sr33.mesh import dot
+
 ARC_MARGIN = 0.5  # free samples keep this far (times h) from a cylinder's rim (else h / 4)
 
 
@@ -82,6 +84,38 @@ class Arc:
             rel = np.where(past, lo, np.clip(rel, lo, hi))
             ang = self.start + rel
         return self.centre + self.radius * np.stack([np.cos(ang), np.sin(ang)], axis=1)
+
+
+def unfold_across_arc(x, circle, arc: Arc, side: float, to2d, reach: float, scale=None, clear=None):
+    """Points of the face across a circular sharp edge unfolded into a
+    face's chart: each at its distance from the edge's circle, straight out
+    from its foot on the circle (exact across a straight edge, first order
+    across an arc).  ``circle`` is the edge's (centre, unit normal, radius)
+    in 3-D, ``arc`` its image in the chart and ``side`` +1 where the face
+    lies inside it (:func:`arc_sides`); only points within ``reach`` of the
+    circle whose feet fall on the arc are kept, and farther than ``clear``
+    when given (the edge's own samples are no frame).  ``scale`` maps the
+    feet's chart points to the chart's scale there (a sphere's
+    stereographic map), else 1."""
+    cc, nn, rr = circle
+    w = x - cc
+    w -= np.outer(dot(w, nn), nn)
+    length = np.linalg.norm(w, axis=1)
+    ok = length > 1e-12 * rr
+    y = cc + rr * w[ok] / length[ok, None]  # the nearest point of the circle
+    d = np.linalg.norm(x[ok] - y, axis=1)
+    near = d < reach if clear is None else (d < reach) & (d > clear)
+    if not near.any():
+        return np.empty((0, 2))
+    yy, d = to2d(y[near]), d[near]
+    ang = (np.arctan2(*(yy - arc.centre).T[::-1]) - arc.start) % (2 * math.pi)
+    on_arc = arc.closed | (ang <= arc.span)
+    yy, d = yy[on_arc], d[on_arc]
+    out_dir = side * (yy - arc.centre)
+    out_dir /= np.linalg.norm(out_dir, axis=1)[:, None]
+    if scale is not None:
+        d = d * scale(yy)
+    return yy + d[:, None] * out_dir
 
 
 def arc_sides(arcs: list[Arc], raster: Raster, h: float) -> list[float]:

@@ -39,6 +39,7 @@ from .chart import (
     halving_count,
     radial_clamp,
     segment_distance,
+    unfold_across_arc,
 )
 from .disks import HALVE_GAP
 from .faces import (
@@ -172,46 +173,30 @@ def _ghosts(arcs: list[Arc], sides: list[float], h: float):
     return ghosts
 
 
-def _band_arcs(nbrs, to2d, raster, arcs: list[Arc], s: Samples, h: float, unfold):
+def _band_arcs(nbrs, to2d, arcs: list[Arc], sides, s: Samples, h: float, unfold):
     """Which of a planar face's arcs (:func:`_arcs`, in its edges' order)
     bound a face in ``unfold`` (a chain of developable faces laid out
     already, :mod:`sr33.samplers.bands`), and that face's samples within
-    ``LAYER`` h of those arcs unfolded into the face's plane: each at its
-    distance from its foot on the circle, straight out from the foot.  They
-    are the repair's judged frame there, in place of the ghost rows (a
-    chamfer's cone round a filleted corner: the ghosts stood where its rows
-    did not, and a triangle of two of its samples and one the top's repair
-    added 0.25 h inside the arc broke III-ii at 0.87)."""
+    ``LAYER`` h of those arcs unfolded into the face's plane
+    (:func:`sr33.samplers.chart.unfold_across_arc`).  They are the repair's
+    judged frame there, in place of the ghost rows (a chamfer's cone round a
+    filleted corner: the ghosts stood where its rows did not, and a triangle
+    of two of its samples and one the top's repair added 0.25 h inside the
+    arc broke III-ii at 0.87)."""
     flags, frames = [], [np.empty((0, 2))]
-    k = 0
-    for e, fb in nbrs:
-        if e.geomType() != "CIRCLE":
-            continue
+    circles = [(e, fb) for e, fb in nbrs if e.geomType() == "CIRCLE"]
+    for (e, fb), a, side in zip(circles, arcs, sides):
         on = fb >= 0 and fb in unfold
         flags.append(on)
         if on:
             circ = e._geomAdaptor().Circle()
-            c3 = np.array(circ.Location().Coord())
-            n3 = np.array(circ.Axis().Direction().Coord())
-            r = float(circ.Radius())
-            sel = np.flatnonzero(s.face_id == fb)
-            q = s.points[sel] - c3
-            radial = q - dot(q, n3)[:, None] * n3
-            rn = np.linalg.norm(radial, axis=1)
-            ok = rn > 1e-12
-            foot = c3 + r * radial[ok] / rn[ok, None]
-            dist = np.linalg.norm(s.points[sel][ok] - foot, axis=1)
-            a = arcs[k]
-            f2 = to2d(foot)
-            w = f2 - a.centre
-            ang = np.arctan2(w[:, 1], w[:, 0])
-            inside_arc = a.closed | ((ang - a.start) % (2 * math.pi) <= a.span)
-            near = (dist < LAYER * h) & (dist > 1e-6 * h) & inside_arc
-            w = w[near] / np.linalg.norm(w[near], axis=1)[:, None]
-            # outwards from the face: away from the centre where the face is inside
-            side = arc_sides([a], raster, h)[0]
-            frames.append(f2[near] + side * dist[near, None] * w)
-        k += 1
+            circle = (
+                np.array(circ.Location().Coord()),
+                np.array(circ.Axis().Direction().Coord()),
+                float(circ.Radius()),
+            )
+            x = s.points[s.face_id == fb]
+            frames.append(unfold_across_arc(x, circle, a, side, to2d, LAYER * h, clear=1e-6 * h))
     return flags, np.vstack(frames)
 
 
@@ -368,6 +353,18 @@ def _plain_lattice(face, row_dir) -> bool:
     return True
 
 
+def _inward(n, a3, u, a2, b2, to2d, raster, h: float):
+    """A straight edge's normal in its planar face (normal ``n``), in plane
+    coordinates and in 3-D (``to2d`` is an isometry), turned to point into
+    the face: the edge runs from ``a3`` along ``u``, ``a2``, ``b2`` its ends
+    in the plane."""
+    m3 = np.cross(n, u)
+    m = to2d((a3 + m3)[None])[0] - a2
+    if not raster(((a2 + b2) / 2 + 0.5 * h * m)[None])[0]:
+        m, m3 = -m, -m3
+    return m, m3
+
+
 def _slanted_lines(
     occ, fi, face, to2d, row_dirs, s: Samples, raster, h, nbrs, squares: bool = False
 ) -> list[_Line]:
@@ -397,12 +394,7 @@ def _slanted_lines(
         if square and not squares:
             continue
         a2, b2 = to2d(np.stack([a3, b3]))
-        # the edge's normal in the face's plane, in 3-D and in plane coordinates
-        # (to2d is an isometry), turned to point into the face
-        m3 = np.cross(n, u)
-        m = to2d((a3 + m3)[None])[0] - a2
-        if not raster(((a2 + b2) / 2 + 0.5 * h * m)[None])[0]:
-            m, m3 = -m, -m3
+        m, m3 = _inward(n, a3, u, a2, b2, to2d, raster, h)
         sel = np.flatnonzero((s.face_id == fb) & ~s.on_feature)
         q = s.points[sel]
         t = dot(q - a3, u)
@@ -449,10 +441,7 @@ def _walls(face, to2d, raster, h: float, lines: list[_Line]) -> list[_Line]:
             for a, b in taken
         ):
             continue
-        u = (b3 - a3) / norm(b3 - a3)
-        m = to2d((a3 + np.cross(n, u))[None])[0] - a2
-        if not raster(((a2 + b2) / 2 + 0.5 * h * m)[None])[0]:
-            m = -m
+        m, _ = _inward(n, a3, (b3 - a3) / norm(b3 - a3), a2, b2, to2d, raster, h)
         out.append(_Line(a2, b2, m, np.empty((0, 2)), False))
     return out
 
@@ -649,7 +638,8 @@ def repair_planar_faces(
             continue
         near_follow = np.min(np.stack([far] + [ln.distance(uv) for ln in follow], axis=1), axis=1)
         anchors = at_corner & (near_follow < tol)
-        banded, arc_frame = _band_arcs(nbrs[fi], to2d, raster, arcs, s, h, unfold)
+        sides = arc_sides(arcs, raster, h)
+        banded, arc_frame = _band_arcs(nbrs[fi], to2d, arcs, sides, s, h, unfold)
         frame = np.vstack(
             [np.empty((0, 2)), arc_frame] + [ln.frame for ln in lines if not ln.follows]
         )
@@ -694,7 +684,6 @@ def repair_planar_faces(
                     by_cur = np.argsort(ang_cur, kind="stable")
                     uv[cur[by_cur]] = rec[np.argsort(ang_rec, kind="stable")]
                     slide[cur] = False
-            sides = arc_sides(arcs, raster, h)
             walls_in = _walls(face, to2d, raster, h, lines)
             clamps = (
                 ([arc_clamp(arcs, sides, h)] if arcs else [])

@@ -1155,9 +1155,15 @@ def scan(
             t0, hf = aligned[fi]
             planes.append((d, t0, hf, _columns(face, d, hf, ratio, *columns[fi])))
         with timed("sample: feature samples"):
-            banded = {f for band in developable_bands(occ, size, sharp_degrees) for f in band.faces}
+            chains = developable_bands(occ, size, sharp_degrees)
             pts, fids, feature_curve, lattices = _feature_samples(
-                occ, EDGE_STEP * h, sharp_degrees, tol, planes, columns, banded
+                occ,
+                EDGE_STEP * h,
+                sharp_degrees,
+                tol,
+                planes,
+                columns,
+                {f for band in chains for f in band.faces},
             )
         pbar.update(1)
         n_feature = len(pts)
@@ -1239,7 +1245,7 @@ def scan(
                 pbar.update(1)
             with timed("sample: developable bands"):
                 more, banded = lattice_developable_bands(
-                    occ, bag, h, size, skip=laid, sharp_degrees=sharp_degrees
+                    occ, bag, h, size, skip=laid, sharp_degrees=sharp_degrees, bands=chains
                 )
             reports += more
             laid |= banded

@@ -26,7 +26,7 @@ import numpy as np
 
 from sr33.mesh import dot, norm
 
-from .chart import Arc, Raster, arc_clamp, arc_sides, segment_distance
+from .chart import Arc, Raster, arc_clamp, arc_sides, segment_distance, unfold_across_arc
 from .faces import (
     Stereographic,
     basis_surface,
@@ -88,34 +88,27 @@ def _rim_frame(face, arcs, sides, to2d: Stereographic, s: Samples, own, h: float
     face's own (``judge_frame``), they keep the samples on either side from
     crowding the rim together (cutcube: a triangle of 0.59 h, 0.69 h and
     0.77 h across the scoop's rim, ratio 0.89)."""
-    others = np.flatnonzero(~own & ~s.on_feature)
-    out = []
+    x = s.points[np.flatnonzero(~own & ~s.on_feature)]
+    out = [np.empty((0, 2))]
     for e, a, side in zip(face.Edges(), arcs, sides):
         circ = e._geomAdaptor().Circle()
-        cc = np.array(circ.Location().Coord())
-        nn = np.array(circ.Axis().Direction().Coord())
-        rr = float(circ.Radius())
-        x = s.points[others]
-        w = x - cc
-        w -= np.outer(dot(w, nn), nn)
-        norm = np.linalg.norm(w, axis=1)
-        ok = norm > 1e-12 * rr
-        y = cc + rr * w[ok] / norm[ok, None]  # the nearest point of the rim's circle
-        d = np.linalg.norm(x[ok] - y, axis=1)
-        near = d < FRAME_REACH * h
-        if not near.any():
-            continue
-        y, d = y[near], d[near]
-        yy = to2d(y)
-        # only where the rim (an arc of its circle) is nearest
-        ang = (np.arctan2(*(yy - a.centre).T[::-1]) - a.start) % (2 * math.pi)
-        on_arc = a.closed | (ang <= a.span)
-        yy, d = yy[on_arc], d[on_arc]
-        out_dir = side * (yy - a.centre)
-        out_dir /= np.linalg.norm(out_dir, axis=1)[:, None]
-        scale = 1.0 + (yy**2).sum(axis=1) / (2.0 * to2d.radius) ** 2
-        out.append(yy + (d * scale)[:, None] * out_dir)
-    return np.vstack(out) if out else np.empty((0, 2))
+        circle = (
+            np.array(circ.Location().Coord()),
+            np.array(circ.Axis().Direction().Coord()),
+            float(circ.Radius()),
+        )
+        out.append(
+            unfold_across_arc(
+                x,
+                circle,
+                a,
+                side,
+                to2d,
+                FRAME_REACH * h,
+                scale=lambda yy: 1.0 + (yy**2).sum(axis=1) / (2.0 * to2d.radius) ** 2,
+            )
+        )
+    return np.vstack(out)
 
 
 def repair_sphere_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
