@@ -831,6 +831,17 @@ def _follow_columns(s: Samples, shifts: dict[int, list], faces, tol: float) -> N
         s.points[sel] = q + move
 
 
+def _extent_along(face, o: np.ndarray, axis: np.ndarray) -> tuple[float, float]:
+    """The least and largest distance along ``axis`` from ``o`` of the
+    points of ``face``'s edges (its extent along a revolved face's axis)."""
+    at = [
+        float(dot(np.array(e.positionAt(x).toTuple()) - o, axis))
+        for e in face.Edges()
+        for x in (0.0, 0.5, 1.0)
+    ]
+    return min(at), max(at)
+
+
 def _full_turns(occ, kind: str):
     """(index, face) of the faces of a surface type that go all the way round
     between whole circles (a partial cylinder is a fillet: its smooth edges
@@ -1293,7 +1304,15 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
 
         along = dot(q, axis)
         radial = np.linalg.norm(q - along[:, None] * axis, axis=1)
-        on = np.abs(radial - along * tan_a) < tol * 10
+        # on this face: on its cone and within its own extent along the axis
+        # (a boolean can leave two faces of one cone, a band between them cut
+        # away, and the rings of one must not run over the other's rim)
+        lo, hi = _extent_along(face, apex, axis)
+        on = (
+            (np.abs(radial - along * tan_a) < tol * 10)
+            & (along > lo - tol * 10)
+            & (along < hi + tol * 10)
+        )
         # the rim: feature samples of the face at its largest distance from the apex
         cand = np.flatnonzero(on & (along > tol))
         if cand.size == 0:

@@ -124,7 +124,9 @@ def test_conforming_samplings_of_generated_models_reconstruct_homeomorphic(featu
         return
     if why is not None:
         # not the theorem's input: counted with its reason, not a counterexample
-        fuzzstats.reject(f"generated model ({feature}) not conforming: {why}")
+        # a survey names the model too, so that a class's failing kinds can be rebuilt
+        case = f": {model.recipe}" if SURVEY else ""
+        fuzzstats.reject(f"generated model ({feature}) not conforming: {why}{case}")
         if SURVEY and why.startswith("II-i"):
             # beyond the guarantee (a thin wedge): how the reconstruction fares there
             try:
