@@ -833,10 +833,14 @@ def _follow_columns(s: Samples, shifts: dict[int, list], faces, tol: float) -> N
 
 def _extent_along(face, o: np.ndarray, axis: np.ndarray) -> tuple[float, float]:
     """The least and largest distance along ``axis`` from ``o`` of the
-    points of ``face``'s edges (its extent along a revolved face's axis)."""
+    points of ``face``'s edges (its extent along a revolved face's axis; a
+    degenerate edge, a point with no curve, is left out)."""
+    from OCP.BRep import BRep_Tool
+
     at = [
         float(dot(np.array(e.positionAt(x).toTuple()) - o, axis))
         for e in face.Edges()
+        if not BRep_Tool.Degenerated_s(e.wrapped)
         for x in (0.0, 0.5, 1.0)
     ]
     return min(at), max(at)
