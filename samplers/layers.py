@@ -831,21 +831,6 @@ def _follow_columns(s: Samples, shifts: dict[int, list], faces, tol: float) -> N
         s.points[sel] = q + move
 
 
-def _extent_along(face, o: np.ndarray, axis: np.ndarray) -> tuple[float, float]:
-    """The least and largest distance along ``axis`` from ``o`` of the
-    points of ``face``'s edges (its extent along a revolved face's axis; a
-    degenerate edge, a point with no curve, is left out)."""
-    from OCP.BRep import BRep_Tool
-
-    at = [
-        float(dot(np.array(e.positionAt(x).toTuple()) - o, axis))
-        for e in face.Edges()
-        if not BRep_Tool.Degenerated_s(e.wrapped)
-        for x in (0.0, 0.5, 1.0)
-    ]
-    return min(at), max(at)
-
-
 def _full_turns(occ, kind: str):
     """(index, face) of the faces of a surface type that go all the way round
     between whole circles (a partial cylinder is a fillet: its smooth edges
@@ -1311,7 +1296,7 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
         # on this face: on its cone and within its own extent along the axis
         # (a boolean can leave two faces of one cone, a band between them cut
         # away, and the rings of one must not run over the other's rim)
-        lo, hi = _extent_along(face, apex, axis)
+        lo, hi = np.sort(_meridian(face, apex, axis, count=2)[1])
         on = (
             (np.abs(radial - along * tan_a) < tol * 10)
             & (along > lo - tol * 10)
