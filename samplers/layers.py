@@ -1999,6 +1999,7 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     return [
         {
             "kind": "revolved rings",
+            "faces": list(range(len(faces))),
             "rows": rows,
             "columns": m,
             "samples": len(new),

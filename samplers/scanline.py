@@ -1122,7 +1122,7 @@ def scan(
             on_feature=res.on_feature,
             meta=meta,
         )
-    with bar(len(faces) + 2 + (10 if repair else 0), "sample", quiet, unit="step") as pbar:
+    with bar(len(faces) + 2 + (11 if repair else 0), "sample", quiet, unit="step") as pbar:
         lo, hi = exact_bounds(occ)
         size = float(norm(hi - lo))
         if area / (h * h * ratio) > 2_000_000:
@@ -1227,6 +1227,7 @@ def scan(
                 lattice_sphere_caps,
                 repair_planar_faces,
             )
+            from .outlines import repair_curved_faces
             from .pyramids import lattice_pyramid
             from .spheres import repair_sphere_faces
 
@@ -1277,6 +1278,12 @@ def scan(
                 with timed(f"sample: {step}"):
                     reports += lay(occ, bag, h, size)
                 pbar.update(1)
+            with timed("sample: curved faces in their charts"):
+                # what no layout took: rims of any curve, seams (a boolean's pieces)
+                took = [f for x in reports for f in x.get("faces", [x.get("face")])]
+                handled = laid | {int(f) for f in took if f is not None}
+                reports += repair_curved_faces(occ, bag, h, size, skip=handled)
+            pbar.update(1)
             points, line_id, face_id, on_feature = (
                 bag.points,
                 bag.line_id,

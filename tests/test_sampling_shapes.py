@@ -1483,3 +1483,76 @@ def test_a_faces_repair_report_does_not_hide_a_broken_face():
         on = r.face_id == x["face"]
         if rep.worst_ratio[on].max() >= 0.9:
             assert x["worst"] >= 0.85 and x["bad"] > 0, x
+
+
+def _notched_cylinder():
+    """The stop 54 survey's model (a boolean seam): a cylinder (radius 0.2,
+    height 0.59) with a ball (radius 0.31) cut from its top off the axis,
+    turned.  The cut leaves a cylinder notched along a B-spline (the curve
+    where they meet) and the ball's dish with that rim and a seam: no
+    layout takes either."""
+    import cadquery as cq
+
+    from tests.strategies import moved
+
+    r, h = 0.20000000000000004, 0.5890878945563615
+    solid = cq.Solid.makeCylinder(r, h, pnt=cq.Vector(0, 0, -h / 2))
+    ball = (
+        cq.Solid.makeSphere(0.5158543122119371, angleDegrees1=-90, angleDegrees2=90)
+        .scale(0.6)
+        .translate(cq.Vector(0.02165115904743084, 0.01822301996327047, 0.29454394727818073))
+    )
+    solid = cq.Solid(solid.cut(ball).Solids()[0].wrapped)
+    solid = moved(
+        solid,
+        [139.94100729204922, 4.89441967723362e-229, 136.97646435628957],
+        [2.629793343154865, 1.7612338076495861, 4.725057160444777],
+    )
+    return shapes.from_cad(solid, name="notched cylinder")
+
+
+def test_a_cylinder_notched_by_a_ball_is_repaired_in_its_charts():
+    """Faces no layout takes are repaired in charts of their own, whatever
+    their rims (:mod:`sr33.samplers.outlines`): the ball's dish on its
+    stereographic map, the notched cylinder unrolled.  Left to the scan
+    rows, 290 of the cylinder's samples and 351 of the dish's broke
+    Condition III-ii (3,007 samples, worst 1.0); now none does, with the
+    margin."""
+    from sr33.validators.fidelity import distance_to_surface
+
+    s = _notched_cylinder()
+    kinds = sorted(f.geomType() for f in s.solid.Faces())
+    assert kinds == ["CYLINDER", "PLANE", "SPHERE"]
+    r, ratio = _geodesic_ratios(s, 1500)
+    h = r.meta["spacing"]
+    done = {x["kind"] for x in r.meta["repairs"]}
+    assert {"sphere chart", "cylinder chart"} <= done
+    assert distance_to_surface(r.points, s.truth_vertices, s.truth_triangles).max() < 0.05 * h
+    assert np.nanmax(ratio) < 0.85
+
+
+def test_an_unrolled_cylinder_is_an_isometry_and_its_raster_wraps():
+    """:class:`sr33.samplers.outlines.Unrolled` maps a cylinder onto the
+    plane keeping lengths along it (arc length round, height along), and
+    back; :class:`sr33.samplers.outlines.TriangleRaster` with its period
+    takes a triangle across the cut whole, at both ends."""
+    from sr33.samplers.outlines import TriangleRaster, Unrolled
+
+    o = np.array([0.3, -0.2, 1.0])
+    ez = np.array([0.0, 0.6, 0.8])
+    ex = np.array([1.0, 0.0, 0.0])
+    ey = np.cross(ez, ex)
+    chart = Unrolled(o, ex, ey, ez, 0.5, cut=1.0)
+    ang = np.array([1.2, 2.0, 4.5, 7.0])
+    z = np.array([0.1, -0.3, 0.25, 0.0])
+    p = o + z[:, None] * ez + 0.5 * (np.cos(ang)[:, None] * ex + np.sin(ang)[:, None] * ey)
+    c = chart(p)
+    np.testing.assert_allclose(c[:, 0], 0.5 * ((ang - 1.0) % (2 * np.pi)))
+    np.testing.assert_allclose(c[:, 1], z, atol=1e-15)
+    np.testing.assert_allclose(chart.inverse(c), p, atol=1e-12)
+    # a triangle across the cut: corners near both ends of [0, period)
+    period = chart.period
+    tri = np.array([[[period - 0.05, 0.0], [0.05, 0.0], [0.0, 0.1]]])
+    inside = TriangleRaster(tri, 0.005, period)
+    got = inside(np.array([[period - 0.01, 0.02], [0.01, 0.02], [0.5, 0.02], [0.0, 0.2]]))
+    assert got.tolist() == [True, True, False, False]

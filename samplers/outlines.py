@@ -1,0 +1,557 @@
+"""Curved faces no layout takes, repaired in their own charts, whatever their rims.
+
+The layouts take whole bands of revolution and caps (:mod:`sr33.samplers.layers`,
+:mod:`sr33.samplers.disks`), and :func:`sr33.samplers.spheres.repair_sphere_faces`
+partial spheres whose rims are circles and that have no seam.  A boolean
+leaves faces none of them takes, and their scan rows end on the rims at
+arbitrary places: a cylinder notched by a ball cut from its top (its rim
+the curve where they meet, a B-spline), and the ball's piece inside it
+(that curve, a circle and its seam).  On the stop 54 survey's model of it
+(3,007 samples), 290 samples of the cylinder and 351 of the ball's piece
+broke Condition III-ii.
+
+Each such face is repaired in a chart of its own (the repair of
+:func:`sr33.samplers.repair.repair`, as for the planar faces):
+
+* a cylinder unrolled (:class:`Unrolled`): an isometry, so the chart's
+  Delaunay triangles and ratios are the surface's;
+* a sphere on its stereographic map from the point opposite the face's
+  centre (:class:`sr33.samplers.faces.Stereographic`): conformal, ratios kept
+  up to the scale's change across a triangle, as for the partial spheres.
+
+The face's rims (its edges but seams and degenerate ones, whatever curves
+they are) are dense points (:class:`Rims`) with the direction into the
+face in the chart; the face's domain is its own tessellation filled into a
+raster (:class:`TriangleRaster`).  Samples on the rims stay; the others
+near them move (all of a sphere's), kept on the face a quarter of h from
+the rims; the neighbours' samples across a rim are unfolded into the chart
+(each at its distance from its nearest rim point, straight out) and judged
+with the face's own.  A cylinder going all the way round is unrolled twice,
+cut in two places half a turn apart: the samples near the cut stay in a
+pass, with their images across it as the frame, and the second pass
+repairs round the first pass's cut.
+
+CadQuery and OCP are imported when the functions run.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from sr33.mesh import dot, norm
+
+from .faces import RIM_SAMPLED, Stereographic, basis_surface, goes_round, steps, whole_band
+from .layers import POLE_GOOD, RASTER, STUCK, unstuck
+from .repair import repair
+from .samples import Samples
+from .spheres import FACING
+
+RIM_STEP = 1.0 / 20.0  # rims as points this far apart (times h)
+LAYER = 3.0  # a developed face's samples this near a rim (times h) move
+CUT_CLEAR = 3.0  # ... unless this near the pass's cut (times h)
+IMAGE_REACH = 2.0  # own samples this near the cut (times h) are imaged across it
+FRAME_REACH = 2.5  # the neighbours' samples this near a rim (times h) are the frame
+CLEAR = 0.25  # free samples keep this far (times h) from the rims
+ON_RIM = 0.1  # a feature sample this near a rim's points (times h; they are h / 20 apart) is on it
+#: a sphere face is mapped when it lies within 78° of its centre (cos >
+#: this, :data:`sr33.samplers.spheres.FACING`): the lattice laid on the map
+#: is denser on the sphere by the map's scale, 1.6 there, against the rims'
+#: samples h apart (a hemisphere's dish, 90°: 21 samples at or above 0.85
+#: where the scan rows had 296, in 70 s of repair)
+REACH = FACING
+ROUNDS = 2
+KEEP_OFF = 0.5  # a laid lattice's points this near a rim (times h) are left out
+
+
+def rim_edges(face) -> list:
+    """The face's rims: its edges but its seams and degenerate ones."""
+    from OCP.BRep import BRep_Tool
+
+    return [
+        e
+        for e in face.Edges()
+        if not (BRep_Tool.Degenerated_s(e.wrapped) or BRep_Tool.IsClosed_s(e.wrapped, face.wrapped))
+    ]
+
+
+class Unrolled:
+    """A cylinder unrolled from the angle ``cut``: a point at angle θ about
+    the axis and height z along it maps to ``(R ((θ - cut) mod 2π), z)``,
+    an isometry onto ``[0, 2π R)`` by the height (``period`` 2π R)."""
+
+    def __init__(self, o, ex, ey, ez, radius: float, cut: float):
+        self.o, self.ex, self.ey, self.ez = o, ex, ey, ez
+        self.radius, self.cut = radius, cut
+        self.period = 2.0 * math.pi * radius
+
+    def __call__(self, p) -> np.ndarray:
+        q = np.asarray(p, dtype=np.float64) - self.o
+        ang = (np.arctan2(dot(q, self.ey), dot(q, self.ex)) - self.cut) % (2.0 * math.pi)
+        return np.stack([self.radius * ang, dot(q, self.ez)], axis=1)
+
+    def inverse(self, c: np.ndarray) -> np.ndarray:
+        ang = self.cut + c[:, 0] / self.radius
+        return (
+            self.o
+            + c[:, 1:] * self.ez
+            + self.radius * (np.cos(ang)[:, None] * self.ex + np.sin(ang)[:, None] * self.ey)
+        )
+
+    def scale(self, c: np.ndarray) -> np.ndarray:
+        return np.ones(c.shape[0])
+
+
+class _Sphere(Stereographic):
+    """The stereographic map with its scale (chart length per length)."""
+
+    period = None
+
+    def scale(self, c: np.ndarray) -> np.ndarray:
+        return 1.0 + (c**2).sum(axis=1) / (2.0 * self.radius) ** 2
+
+
+class TriangleRaster:
+    """Inside test of a domain given as triangles (``(t, 3, 2)``): the
+    cells of side ``cell`` whose centres lie in a triangle.  With
+    ``period``, the domain repeats along the first axis: a triangle across
+    ``[0, period)``'s ends is taken whole, and points are looked up modulo
+    the period."""
+
+    def __init__(self, tri: np.ndarray, cell: float, period: float | None = None):
+        tri = np.asarray(tri, dtype=np.float64)
+        if period is not None:
+            x = tri[..., 0]
+            # a triangle across the cut has corners near both ends: lift the low ones
+            across = (x.max(axis=1) - x.min(axis=1)) > 0.5 * period
+            x[across] = np.where(x[across] < 0.5 * period, x[across] + period, x[across])
+            tri = np.concatenate([tri, tri - [period, 0.0]])
+        lo = tri.reshape(-1, 2).min(axis=0) - 2 * cell
+        hi = tri.reshape(-1, 2).max(axis=0) + 2 * cell
+        if period is not None:
+            lo[0], hi[0] = 0.0, period
+        self.lo, self.cell, self.period = lo, cell, period
+        nx, ny = (np.ceil((hi - lo) / cell).astype(int) + 1).tolist()
+        self.grid = np.zeros((ny, nx), dtype=bool)
+        i0 = np.ceil((tri.min(axis=1) - lo) / cell - 0.5).astype(np.int64)
+        i1 = np.floor((tri.max(axis=1) - lo) / cell - 0.5).astype(np.int64)
+        i0 = np.maximum(i0, 0)
+        i1 = np.minimum(i1, [nx - 1, ny - 1])
+        span = np.maximum(i1 - i0 + 1, 0)
+        counts = span[:, 0] * span[:, 1]
+        k = np.repeat(np.arange(tri.shape[0]), counts)
+        local = np.arange(k.size) - np.repeat(np.cumsum(counts) - counts, counts)
+        ix = i0[k, 0] + local % np.maximum(span[k, 0], 1)
+        iy = i0[k, 1] + local // np.maximum(span[k, 0], 1)
+        c = lo + (np.stack([ix, iy], axis=1) + 0.5) * cell
+        a, b, d = tri[k, 0], tri[k, 1], tri[k, 2]
+        den = (b[:, 0] - a[:, 0]) * (d[:, 1] - a[:, 1]) - (d[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+        ok = np.abs(den) > 0
+        den = np.where(ok, den, 1.0)
+        w1 = (
+            (c[:, 0] - a[:, 0]) * (d[:, 1] - a[:, 1]) - (d[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1])
+        ) / den
+        w2 = (
+            (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+        ) / den
+        eps = 1e-9
+        ok &= (w1 >= -eps) & (w2 >= -eps) & (w1 + w2 <= 1 + eps)
+        self.grid[iy[ok], ix[ok]] = True
+
+    def __call__(self, pts: np.ndarray) -> np.ndarray:
+        pts = np.asarray(pts, dtype=np.float64)
+        if self.period is not None:
+            pts = np.stack([pts[:, 0] % self.period, pts[:, 1]], axis=1)
+        ij = np.floor((pts - self.lo) / self.cell).astype(np.int64)
+        ny, nx = self.grid.shape
+        ok = (ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny)
+        out = np.zeros(pts.shape[0], dtype=bool)
+        out[ok] = self.grid[ij[ok, 1], ij[ok, 0]]
+        return out
+
+
+def _face_triangles(face, tol: float) -> np.ndarray:
+    """The face's own tessellation (tolerance ``tol``) as 3-D triangles ``(t, 3, 3)``."""
+    verts, tris = face.tessellate(tol, 0.1)
+    v = np.array([q.toTuple() for q in verts])
+    t = np.array(tris, dtype=np.int64).reshape(-1, 3)
+    return v[t]
+
+
+class Rims:
+    """A face's rims (:func:`rim_edges`) as points ``RIM_STEP`` h apart:
+    ``p3`` in space, ``c`` in the chart, ``inward`` the unit direction into
+    the face there (in the chart)."""
+
+    def __init__(self, edges, chart, inside, h: float):
+        p3, c, inward = [], [], []
+        period = chart.period
+        for e in edges:
+            n = max(2, math.ceil(e.Length() / (RIM_STEP * h))) + 1
+            q = np.array([v.toTuple() for v in e.positions(np.linspace(0.0, 1.0, n))])
+            cq_ = chart(q)
+            d = np.gradient(cq_, axis=0)
+            if period is not None:  # across the cut, the short way
+                d[:, 0] -= period * np.round(d[:, 0] / period)
+            nrm = np.stack([-d[:, 1], d[:, 0]], axis=1)
+            nrm /= np.maximum(np.linalg.norm(nrm, axis=1), 1e-300)[:, None]
+            probe = 0.3 * h * chart.scale(cq_)[:, None] * nrm
+            plus, minus = inside(cq_ + probe), inside(cq_ - probe)
+            # per point where the probes disagree, else the edge's majority
+            sign = np.where(plus & ~minus, 1.0, np.where(minus & ~plus, -1.0, 0.0))
+            sign[sign == 0] = 1.0 if (sign > 0).sum() >= (sign < 0).sum() else -1.0
+            p3.append(q)
+            c.append(cq_)
+            inward.append(sign[:, None] * nrm)
+        self.p3 = np.vstack(p3)
+        self.c = np.vstack(c)
+        self.inward = np.vstack(inward)
+        self.tree3 = cKDTree(self.p3)
+        self.tree2 = cKDTree(self.c)
+        self.scale = chart.scale(self.c)
+
+    def distance(self, x: np.ndarray) -> np.ndarray:
+        """Distance in space from each point to the rims (to ``RIM_STEP`` h)."""
+        return self.tree3.query(x)[0]
+
+    def clamp(self, inside, margin: float):
+        """Keep free samples in the face and ``margin`` (times the chart's
+        scale) from the rims: one too near, or outside, goes to its nearest
+        rim point's inward normal at that distance."""
+
+        def run(p: np.ndarray) -> np.ndarray:
+            d, j = self.tree2.query(p)
+            gap = margin * self.scale[j]
+            bad = (d < gap) | ~inside(p)
+            if not bad.any():
+                return p
+            out = p.copy()
+            out[bad] = self.c[j[bad]] + gap[bad, None] * self.inward[j[bad]]
+            return out
+
+        return run
+
+    def unfold(self, x: np.ndarray, reach: float, clear: float) -> np.ndarray:
+        """Points across the rims (in space) unfolded into the chart: each
+        at its distance from its nearest rim point, straight out of the
+        face; only those within ``reach`` of a rim and farther than ``clear``."""
+        if x.shape[0] == 0:
+            return np.empty((0, 2))
+        d, j = self.tree3.query(x)
+        keep = (d < reach) & (d > clear)
+        d, j = d[keep], j[keep]
+        return self.c[j] - (d * self.scale[j])[:, None] * self.inward[j]
+
+
+def _sphere_chart(face):
+    """A sphere face's stereographic map from the point opposite its
+    centre, or None where it reaches more than ``FACING`` round."""
+    sph = basis_surface(face).Sphere()
+    centre = np.array(sph.Location().Coord())
+    radius = float(sph.Radius())
+    pole = np.array(face.Center().toTuple()) - centre
+    if norm(pole) < 1e-9 * radius:
+        return None
+    pole /= norm(pole)
+    return _Sphere(centre, radius, pole)
+
+
+def _cylinder(face):
+    cyl = basis_surface(face).Cylinder()
+    pos = cyl.Position()
+    return (
+        np.array(pos.Location().Coord()),
+        np.array(pos.XDirection().Coord()),
+        np.array(pos.YDirection().Coord()),
+        np.array(pos.Direction().Coord()),
+        float(cyl.Radius()),
+    )
+
+
+def _on_surface(face, points: np.ndarray, tol: float) -> np.ndarray:
+    """Whether each point lies on the face's sphere or cylinder (to ``tol``)."""
+    if face.geomType() == "SPHERE":
+        sph = basis_surface(face).Sphere()
+        d = np.linalg.norm(points - np.array(sph.Location().Coord()), axis=1)
+        return np.abs(d - float(sph.Radius())) < tol
+    o, _, _, ez, radius = _cylinder(face)
+    q = points - o
+    radial = np.linalg.norm(q - dot(q, ez)[:, None] * ez, axis=1)
+    return np.abs(radial - radius) < tol
+
+
+def _repair_in(fi, face, chart, tri3, rims_of, s: Samples, h, tol, movable, good, images):
+    """One repair of face ``fi`` in ``chart``: ``movable(c, d)`` says
+    which of its samples (at ``c`` in the chart, ``d`` from the rims in
+    space) may move; ``images`` whether its samples near the chart's cut are imaged
+    across it.  Returns the report, or None when nothing moves."""
+    tri = chart(tri3.reshape(-1, 3)).reshape(-1, 3, 2)
+    inside = TriangleRaster(tri, h / RASTER, chart.period)
+    rims = Rims(rims_of, chart, inside, h)
+    near_rim = rims.distance(s.points) < ON_RIM * h
+    on = _on_surface(face, s.points, tol)
+    cand = np.flatnonzero(on | (near_rim & s.on_feature))
+    c = chart(s.points[cand])
+    mine = inside(c) | (near_rim[cand] & s.on_feature[cand])
+    idx, c = cand[mine], c[mine]
+    if idx.size == 0:
+        return None
+    order = np.lexsort((np.round(c[:, 1] / h, 6), np.round(c[:, 0] / h, 6)))
+    idx, c = idx[order], c[order]
+    fixed = s.on_feature[idx]
+    free = ~fixed & movable(c, rims.distance(s.points[idx]))
+    if not free.any():
+        return None
+    own = np.zeros(s.points.shape[0], dtype=bool)
+    own[idx] = True
+    frame = [rims.unfold(s.points[~own & ~s.on_feature], FRAME_REACH * h, 1e-6 * h)]
+    if images and chart.period is not None:
+        reach = IMAGE_REACH * h
+        low, high = c[:, 0] < reach, c[:, 0] > chart.period - reach
+        frame += [c[low] + [chart.period, 0.0], c[high] - [chart.period, 0.0]]
+    args = dict(
+        inside=inside,
+        clamp=rims.clamp(inside, CLEAR * h),
+        frame=np.vstack(frame),
+        judge_frame=True,
+    )
+    r = unstuck(c, free, h, repair(c, free, h, **args), good, **args)
+    pts3 = chart.inverse(r.uv)
+    kept = r.origin >= 0
+    stay = kept & ~free[np.maximum(r.origin, 0)]
+    pts3[stay] = s.points[idx[r.origin[stay]]]  # the fixed samples exactly where they were
+    return s.put(idx, r, pts3, fi, f"{face.geomType().lower()} chart")
+
+
+def _lay_lattice(fi, face, chart, tri3, rims_of, s: Samples, h: float, tol: float) -> None:
+    """Replace the face's samples off its rims by a square lattice of side
+    h in the chart (rows along its first axis, one through the origin: its
+    Delaunay triangles are right isosceles, ratio 1/√2 on the map), without
+    the points nearer than ``KEEP_OFF`` h to a rim.  The chart's scale is
+    at least 1 (1 at a stereographic map's centre), so the samples are at
+    most h apart on the surface."""
+    tri = chart(tri3.reshape(-1, 3)).reshape(-1, 3, 2)
+    inside = TriangleRaster(tri, h / RASTER, chart.period)
+    on = np.flatnonzero(_on_surface(face, s.points, tol))
+    drop = on[inside(chart(s.points[on])) & _off_rims(s, on, rims_of, h)]
+    lo, hi = tri.reshape(-1, 2).min(axis=0), tri.reshape(-1, 2).max(axis=0)
+    rows = np.arange(math.floor(lo[1] / h) - 1, math.ceil(hi[1] / h) + 2)
+    cols = np.arange(math.floor(lo[0] / h) - 1, math.ceil(hi[0] / h) + 2)
+    jj, ii = np.meshgrid(rows, cols, indexing="ij")
+    c = np.stack([ii * h, jj * h], axis=-1).reshape(-1, 2).astype(np.float64)
+    row = jj.reshape(-1) - rows[0]
+    keep = inside(c)
+    c, row = c[keep], row[keep]
+    p3 = chart.inverse(c)
+    far = cKDTree(rims_of).query(p3)[0] >= KEEP_OFF * h
+    p3, row = p3[far], row[far]
+    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
+    s.replace(
+        drop,
+        p3,
+        line + row,
+        np.full(row.size, fi),
+        np.zeros(row.size, dtype=bool),
+    )
+
+
+def _lay_cylinder(fi, face, rims_of, s: Samples, h: float, tol: float) -> None:
+    """Replace a cylinder face's samples off its rims by the lattice its
+    unrolled chart carries: columns at the angles of the samples on a whole
+    circle round it (its lowest one, as :func:`sr33.samplers.layers.lattice_cylinder_faces`
+    takes a rim's), else evenly spaced (about h apart), and rows as far
+    apart as the columns from that circle (else from the face's lowest
+    point), so that the cells are squares; without the points nearer than
+    ``KEEP_OFF`` h to a rim."""
+    o, ex, ey, ez, radius = _cylinder(face)
+    umin, umax, vmin, vmax = face._uvBounds()
+    round_ = goes_round(face)
+    chart = Unrolled(o, ex, ey, ez, radius, umin if round_ else 0.5 * (umin + umax) + math.pi)
+    q = s.points - o
+    axial = dot(q, ez)
+    radial = np.linalg.norm(q - axial[:, None] * ez, axis=1)
+    on = (np.abs(radial - radius) < tol) & (axial > vmin - tol) & (axial < vmax + tol)
+    angles, z0 = None, vmin
+    circles = [
+        e
+        for e in rims_of
+        if e.geomType() == "CIRCLE"
+        and e.IsClosed()
+        and abs(abs(dot(np.array(e.normal().toTuple()), ez)) - 1.0) < 1e-9
+    ]
+    for e in sorted(circles, key=lambda e: float(dot(np.array(e.Center().toTuple()) - o, ez))):
+        at = float(dot(np.array(e.Center().toTuple()) - o, ez))
+        mine = on & s.on_feature & (np.abs(axial - at) < tol)
+        if mine.sum() >= 3:
+            angles = np.sort(np.arctan2(dot(q[mine], ey), dot(q[mine], ex)) % (2 * math.pi))
+            z0 = at
+            break
+    if angles is None:
+        if round_:
+            n = steps(2 * math.pi * radius, h, 3)
+            angles = umin + 2 * math.pi * np.arange(n) / n
+        else:
+            n = steps(radius * (umax - umin), h, 1)
+            angles = umin + (umax - umin) * np.arange(1, n) / n
+    gap = radius * (2 * math.pi if round_ else umax - umin) / max(angles.size, 1)
+    k = np.arange(math.floor((vmin - z0) / gap), math.ceil((vmax - z0) / gap) + 1)
+    z = z0 + k[k != 0] * gap
+    z = z[(z > vmin) & (z < vmax)]
+    zz, aa = np.repeat(z, angles.size), np.tile(angles, z.size)
+    row = np.repeat(np.arange(z.size), angles.size)
+    p3 = o + zz[:, None] * ez + radius * (np.cos(aa)[:, None] * ex + np.sin(aa)[:, None] * ey)
+    tri = chart(_face_triangles(face, h / 20).reshape(-1, 3)).reshape(-1, 3, 2)
+    inside = TriangleRaster(tri, h / RASTER, chart.period)
+    rims_pts = rims_of_points(rims_of, h)
+    keep = inside(chart(p3)) & (cKDTree(rims_pts).query(p3)[0] >= KEEP_OFF * h)
+    p3, row = p3[keep], row[keep]
+    idx = np.flatnonzero(on)
+    drop = idx[inside(chart(s.points[idx])) & _off_rims(s, idx, rims_pts, h)]
+    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
+    s.replace(drop, p3, line + row, np.full(row.size, fi), np.zeros(row.size, dtype=bool))
+
+
+def _off_rims(s: Samples, idx: np.ndarray, rims: np.ndarray, h: float) -> np.ndarray:
+    """Which of the samples ``idx`` a laid lattice replaces: those off the
+    features, and feature samples off the rims (points ``rims``): a seam's
+    end, which the scan samples as a corner (a ball's pole)."""
+    far = cKDTree(rims).query(s.points[idx])[0] > ON_RIM * h
+    return ~s.on_feature[idx] | far
+
+
+def rims_of_points(edges, h: float) -> np.ndarray:
+    """The edges as points ``RIM_STEP`` h apart (in space)."""
+    out = [np.empty((0, 3))]
+    for e in edges:
+        n = max(2, math.ceil(e.Length() / (RIM_STEP * h))) + 1
+        out.append(np.array([v.toTuple() for v in e.positions(np.linspace(0.0, 1.0, n))]))
+    return np.vstack(out)
+
+
+def _cut_pass(c: np.ndarray, d: np.ndarray, *, h: float, period: float, passes: int, k: int):
+    """Which samples of an unrolled cylinder move in pass ``k`` of ``passes``
+    (at ``c`` in the chart, ``d`` from the rims): those within ``LAYER`` h
+    of a rim; with two passes, not within ``CUT_CLEAR`` h of the pass's
+    cut, and in the second only those round the first pass's cut (half a
+    turn on)."""
+    layer = d < LAYER * h
+    if passes == 1:
+        return layer
+    away = np.minimum(c[:, 0], period - c[:, 0]) > CUT_CLEAR * h
+    if k == 0:
+        return layer & away
+    return layer & away & (np.abs(c[:, 0] - 0.5 * period) < (CUT_CLEAR + 1.0) * h)
+
+
+def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()) -> list[dict]:
+    """Repair every sphere and cylinder face that no layout took (not in
+    ``skip``) and whose rims are all sampled, in its own chart (see the
+    module's notes).
+
+    Parameters
+    ----------
+    occ : cadquery.Shape
+        The shape sampled.
+    s : Samples
+        Its samples, edited in place.
+    h : float
+        The sample spacing.
+    size : float
+        The shape's bounding-box diagonal (tolerances).
+    skip : set of int
+        Faces laid out or repaired already.
+
+    Returns
+    -------
+    list of dict
+        One report per repair (kind ``"sphere chart"`` or ``"cylinder
+        chart"``; a cylinder going all the way round has two).
+
+    Notes
+    -----
+    Condition III-ii of the paper (Section 3) on the faces the layouts
+    leave to the scan rows; the spheres first (all their samples move),
+    then the cylinders' boundary layers with the spheres' answers across
+    their rims.
+    """
+    tol = 1e-7 * size
+    reports: list[dict] = []
+    faces = occ.Faces()
+    spheres, cylinders = [], []
+    for fi, face in enumerate(faces):
+        kind = face.geomType()
+        if fi in skip or kind not in ("SPHERE", "CYLINDER"):
+            continue
+        rims = rim_edges(face)
+        if not rims:
+            continue
+        feature = s.points[s.on_feature]
+        if feature.shape[0] == 0:
+            return reports
+        mids = np.array([e.positionAt(0.5).toTuple() for e in rims])
+        if cKDTree(feature).query(mids)[0].max() > RIM_SAMPLED * h:
+            continue  # a smooth edge: the face blends into its neighbour
+        if kind == "SPHERE":
+            spheres.append((fi, face, rims))
+        elif not whole_band(face):
+            cylinders.append((fi, face, rims))
+    charts = {}
+    for fi, face, rims in spheres:
+        chart = _sphere_chart(face)
+        if chart is None:
+            continue
+        tri3 = _face_triangles(face, h / 20)
+        if dot(tri3.reshape(-1, 3) - chart.centre, chart.pole).min() <= REACH * chart.radius:
+            continue  # the face wraps too far round for one map
+        charts[fi] = (chart, tri3)
+        _lay_lattice(fi, face, chart, tri3, rims_of_points(rims, h), s, h, tol)
+    for fi, face, rims in cylinders:
+        _lay_cylinder(fi, face, rims, s, h, tol)
+    for _ in range(ROUNDS):
+        for fi, face, rims in spheres:
+            if fi not in charts:
+                continue
+            chart, tri3 = charts[fi]
+            rep = _repair_in(
+                fi,
+                face,
+                chart,
+                tri3,
+                rims,
+                s,
+                h,
+                tol,
+                lambda c, d: d < LAYER * h,
+                POLE_GOOD,
+                images=False,
+            )
+            if rep is not None:
+                reports.append(rep)
+        for fi, face, rims in cylinders:
+            o, ex, ey, ez, radius = _cylinder(face)
+            tri3 = _face_triangles(face, h / 20)
+            umin, umax, _, _ = face._uvBounds()
+            # a face going round: cut where its seam is, then half a turn on;
+            # else in the middle of the missing turn
+            cuts = [umin, umin + math.pi] if goes_round(face) else [0.5 * (umin + umax) + math.pi]
+            for k, cut in enumerate(cuts):
+                chart = Unrolled(o, ex, ey, ez, radius, cut)
+                rep = _repair_in(
+                    fi,
+                    face,
+                    chart,
+                    tri3,
+                    rims,
+                    s,
+                    h,
+                    tol,
+                    functools.partial(_cut_pass, h=h, period=chart.period, passes=len(cuts), k=k),
+                    STUCK,
+                    images=len(cuts) > 1,
+                )
+                if rep is not None:
+                    reports.append(rep)
+    return reports
