@@ -63,7 +63,11 @@ ON_RIM = 0.1  # a feature sample this near a rim's points (times h; they are h /
 #: samples h apart (a hemisphere's dish, 90°: 21 samples at or above 0.85
 #: where the scan rows had 296, in 70 s of repair)
 REACH = FACING
+#: the dishes, then the cylinders, repaired this many times over (each
+#: round's repairs see the other faces' answers across the rims)
 ROUNDS = 2
+#: a ball with a bite: its rims lie within this angle of the bite's centre
+BITE = math.radians(110.0)
 KEEP_OFF = 0.5  # a laid lattice's points this near a rim (times h) are left out
 
 
@@ -283,13 +287,32 @@ def _on_surface(face, points: np.ndarray, tol: float) -> np.ndarray:
     return np.abs(radial - radius) < tol
 
 
-def _repair_in(fi, face, chart, tri3, rims_of, s: Samples, h, tol, movable, good, images):
+def _repair_in(
+    fi,
+    face,
+    chart,
+    tri3,
+    rims_of,
+    s: Samples,
+    h,
+    tol,
+    movable,
+    good,
+    images,
+    inside=None,
+    step=None,
+):
     """One repair of face ``fi`` in ``chart``: ``movable(c, d)`` says
     which of its samples (at ``c`` in the chart, ``d`` from the rims in
-    space) may move; ``images`` whether its samples near the chart's cut are imaged
-    across it.  Returns the report, or None when nothing moves."""
-    tri = chart(tri3.reshape(-1, 3)).reshape(-1, 3, 2)
-    inside = TriangleRaster(tri, h / RASTER, chart.period)
+    space) may move; ``images`` whether its samples near the chart's cut
+    are imaged across it; ``inside`` the face's domain in the chart
+    (default: its tessellation ``tri3`` filled in); ``step`` the spacing the
+    repair aims at in the chart (default h).  Returns the report, or None
+    when nothing moves."""
+    if inside is None:
+        tri = chart(tri3.reshape(-1, 3)).reshape(-1, 3, 2)
+        inside = TriangleRaster(tri, h / RASTER, chart.period)
+    step = h if step is None else step
     rims = Rims(rims_of, chart, inside, h)
     near_rim = rims.distance(s.points) < ON_RIM * h
     on = _on_surface(face, s.points, tol)
@@ -318,7 +341,7 @@ def _repair_in(fi, face, chart, tri3, rims_of, s: Samples, h, tol, movable, good
         frame=np.vstack(frame),
         judge_frame=True,
     )
-    r = unstuck(c, free, h, repair(c, free, h, **args), good, **args)
+    r = unstuck(c, free, step, repair(c, free, step, **args), good, **args)
     pts3 = chart.inverse(r.uv)
     kept = r.origin >= 0
     stay = kept & ~free[np.maximum(r.origin, 0)]
@@ -431,6 +454,82 @@ def rims_of_points(edges, h: float) -> np.ndarray:
     return np.vstack(out)
 
 
+def _bitten_ball(fi, face, rims, s: Samples, h: float, tol: float, size: float):
+    """A sphere face too wide for one map (a ball with a bite taken out by
+    a box or another ball): laid as the whole ball is
+    (:func:`sr33.samplers.layers.lattice_revolved_body`, rings with halving
+    columns between two poles) about the axis through the face's centre,
+    whose far pole lies in the bite, keeping the rings' samples on the face
+    and h / 2 off its rims; then its rims' boundary layer is repaired on the
+    stereographic map centred in the bite (the rims within ``BITE`` of its
+    centre, where the map's scale is at most 1 / cos²(BITE / 2)).  Returns
+    the report, or None where the face is not of that kind."""
+    import cadquery as cq
+
+    from .layers import lattice_revolved_body
+
+    chart = _sphere_chart(face)
+    if chart is None:
+        return None
+    centre, radius, axis = chart.centre, chart.radius, chart.pole
+    bite = _Sphere(centre, radius, -axis)  # projected from the face's centre
+    rim_pts = rims_of_points(rims, h)
+    rim_cos = dot(rim_pts - centre, -axis) / radius
+    if rim_cos.min() <= math.cos(BITE):
+        return None  # a rim far from the bite (two bites): not one map's
+    tri3 = _face_triangles(face, h / 20)
+    # the bite's map, filled in as far as 20° past the farthest rim: beyond
+    # 10° past it, all is the face (the map runs to infinity at its centre)
+    far = math.acos(max(-1.0, rim_cos.min()))
+    near = (dot(tri3.reshape(-1, 3) - centre, -axis).reshape(-1, 3) / radius) > math.cos(
+        min(far + math.radians(20.0), math.pi * 0.95)
+    )
+    raster = TriangleRaster(
+        bite(tri3[near.all(axis=1)].reshape(-1, 3)).reshape(-1, 3, 2), h / RASTER
+    )
+    beyond = 2.0 * radius * math.tan(min(far + math.radians(10.0), math.pi * 0.9) / 2.0)
+
+    def inside(c: np.ndarray) -> np.ndarray:
+        return raster(c) | (np.linalg.norm(c, axis=1) > beyond)
+
+    ball = cq.Solid.makeSphere(
+        radius, cq.Vector(*centre), cq.Vector(*axis), angleDegrees1=-90, angleDegrees2=90
+    )
+    poles = np.array([centre + radius * axis, centre - radius * axis])
+    laid = Samples(poles, np.full(2, -1), np.zeros(2, dtype=np.int64), np.ones(2, dtype=bool))
+    if not lattice_revolved_body(ball, laid, h, size):
+        return None
+    p3 = laid.points
+    keep = inside(bite(p3)) & (cKDTree(rim_pts).query(p3)[0] >= KEEP_OFF * h)
+    p3, rows = p3[keep], laid.line_id[keep]
+    on = np.flatnonzero(_on_surface(face, s.points, tol))
+    drop = on[inside(bite(s.points[on])) & _off_rims(s, on, rim_pts, h)]
+    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
+    s.replace(
+        drop,
+        p3,
+        line + np.maximum(rows, 0),
+        np.full(p3.shape[0], fi),
+        np.zeros(p3.shape[0], dtype=bool),
+    )
+    scale = float(np.median(bite.scale(bite(rim_pts))))
+    return _repair_in(
+        fi,
+        face,
+        bite,
+        tri3,
+        rims,
+        s,
+        h,
+        tol,
+        lambda c, d: d < LAYER * h,
+        POLE_GOOD,
+        images=False,
+        inside=inside,
+        step=h * scale,
+    )
+
+
 def _cut_pass(c: np.ndarray, d: np.ndarray, *, h: float, period: float, passes: int, k: int):
     """Which samples of an unrolled cylinder move in pass ``k`` of ``passes``
     (at ``c`` in the chart, ``d`` from the rims): those within ``LAYER`` h
@@ -481,6 +580,9 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
     reports: list[dict] = []
     faces = occ.Faces()
     spheres, cylinders = [], []
+    feature = s.points[s.on_feature]
+    if feature.shape[0] == 0:
+        return reports
     for fi, face in enumerate(faces):
         kind = face.geomType()
         if fi in skip or kind not in ("SPHERE", "CYLINDER"):
@@ -488,9 +590,6 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
         rims = rim_edges(face)
         if not rims:
             continue
-        feature = s.points[s.on_feature]
-        if feature.shape[0] == 0:
-            return reports
         mids = np.array([e.positionAt(0.5).toTuple() for e in rims])
         if cKDTree(feature).query(mids)[0].max() > RIM_SAMPLED * h:
             continue  # a smooth edge: the face blends into its neighbour
@@ -498,18 +597,23 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
             spheres.append((fi, face, rims))
         elif not whole_band(face):
             cylinders.append((fi, face, rims))
-    charts = {}
+    charts, wide = {}, []
     for fi, face, rims in spheres:
         chart = _sphere_chart(face)
         if chart is None:
             continue
         tri3 = _face_triangles(face, h / 20)
         if dot(tri3.reshape(-1, 3) - chart.centre, chart.pole).min() <= REACH * chart.radius:
-            continue  # the face wraps too far round for one map
+            wide.append((fi, face, rims))  # too far round for one map
+            continue
         charts[fi] = (chart, tri3)
         _lay_lattice(fi, face, chart, tri3, rims_of_points(rims, h), s, h, tol)
     for fi, face, rims in cylinders:
         _lay_cylinder(fi, face, rims, s, h, tol)
+    for fi, face, rims in wide:
+        rep = _bitten_ball(fi, face, rims, s, h, tol, size)
+        if rep is not None:
+            reports.append(rep)
     for _ in range(ROUNDS):
         for fi, face, rims in spheres:
             if fi not in charts:
