@@ -128,8 +128,10 @@ def refine_to_edge_length(
         t = np.concatenate(out)
 
 
-#: the widest search (nearest vertices whose triangles are searched)
-WIDEST = 256
+#: a point in a triangle lies within this share of its longest edge of its
+#: centroid (the farthest corner is 2/3 of its median away, and a median is
+#: at most the longest edge)
+CENTROID_REACH = 2.0 / 3.0
 
 
 def _longest_edge(v: np.ndarray, t: np.ndarray) -> float:
@@ -141,8 +143,7 @@ def _longest_edge(v: np.ndarray, t: np.ndarray) -> float:
 
 def _nearest_triangles(p, v, t, inc, tree, kk: int):
     """Per point, the nearest of the triangles round its ``kk`` nearest
-    vertices: triangle, barycentric coordinates, and the distance to the
-    kk-th vertex (inf when that is all of them)."""
+    vertices: triangle, barycentric coordinates, distance."""
     kk = min(kk, v.shape[0])
     _, near = tree.query(p, kk)
     near = near.reshape(p.shape[0], kk)
@@ -167,8 +168,7 @@ def _nearest_triangles(p, v, t, inc, tree, kk: int):
     full_bary[ok] = bary
     pick = np.argmin(dist.reshape(p.shape[0], width), axis=1)
     at = np.arange(p.shape[0]) * width + pick
-    kth = tree.query(p, kk)[0].reshape(p.shape[0], kk)[:, -1] if kk < v.shape[0] else np.inf
-    return flat[at], full_bary[at], np.broadcast_to(kth, (p.shape[0],)).copy()
+    return flat[at], full_bary[at], dist[at]
 
 
 def insert_points(vertices, triangles, points, *, candidates: int = 4):
@@ -212,7 +212,7 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
     t = np.asarray(triangles, dtype=np.int64).copy()
     pts = np.asarray(points, dtype=np.float64)
     n = pts.shape[0]
-    # the points lie near the surface, not on it: a margin of their distance
+    # rounding, in the search's reach below
     slack = 1e-6 * float(np.ptp(v, axis=0).max()) if v.size else 0.0
     index = np.full(n, -1, dtype=np.int64)
     pending = np.arange(n)
@@ -222,22 +222,31 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
             (np.ones(t.size), (t.ravel(), np.repeat(np.arange(t.shape[0]), 3))), (nv, t.shape[0])
         )
         tree = cKDTree(v)
-        # a point in a triangle is within its longest edge of every corner:
-        # the search takes every vertex that near (the nearest few alone
-        # missed a ball's dish sample's own triangle where the dish meets a
-        # cylinder's wall at a sharp rim, whose vertices were nearer: it
-        # split a wall triangle, folding the mesh into a cone point that
-        # geodesics bent round, 1.93 h between samples 0.78 h apart)
-        reach = 1.05 * _longest_edge(v, t) + slack
-        best_tri, best_bary, kth = _nearest_triangles(pts[pending], v, t, inc, tree, candidates)
-        wide = candidates
-        while wide < min(nv, WIDEST):
-            short = np.flatnonzero(kth < reach)
-            if short.size == 0:
-                break
-            wide = min(4 * wide, nv, WIDEST)
-            tri2, bary2, kth2 = _nearest_triangles(pts[pending[short]], v, t, inc, tree, wide)
-            best_tri[short], best_bary[short], kth[short] = tri2, bary2, kth2
+        best_tri, best_bary, best_d = _nearest_triangles(pts[pending], v, t, inc, tree, candidates)
+        # the triangles round a few nearest vertices can miss the point's
+        # own (a ball's dish meeting a cylinder's wall at a sharp rim: the 4
+        # nearest vertices were the wall's, and a dish sample split a wall
+        # triangle, folding the mesh into a cone point that geodesics bent
+        # round, 1.93 h between samples 0.78 h apart).  A point over a
+        # triangle lies within 2/3 of its longest edge of its centroid (in
+        # its plane), and within the pick's distance off it: every triangle
+        # that near is searched too
+        centroid = v[t].mean(axis=1)
+        near = cKDTree(centroid).query_ball_point(
+            pts[pending], CENTROID_REACH * _longest_edge(v, t) + best_d + slack
+        )
+        count = np.array([len(x) for x in near], dtype=np.int64)
+        if count.sum():
+            which = np.repeat(np.arange(pending.size), count)
+            tri = np.concatenate([np.asarray(x, dtype=np.int64) for x in near if x])
+            d, bary = closest_points_on_triangles(pts[pending][which], v[t[tri]])
+            # per point, the nearest (the first of equals, in the tree's order)
+            order = np.lexsort((np.arange(d.size), d, which))
+            first = order[np.r_[True, which[order][1:] != which[order][:-1]]]
+            rows = which[first]
+            better = d[first] < best_d[rows]
+            rows, first = rows[better], first[better]
+            best_tri[rows], best_bary[rows], best_d[rows] = tri[first], bary[first], d[first]
         edges, tedge = _edges_of(t)
         touched = np.zeros(t.shape[0], dtype=bool)  # split this round (replaced below)
         new_tris: list[list[int]] = []
