@@ -169,11 +169,13 @@ class TriangleRaster:
         pts = np.asarray(pts, dtype=np.float64)
         if self.period is not None:
             pts = np.stack([pts[:, 0] % self.period, pts[:, 1]], axis=1)
-        ij = np.floor((pts - self.lo) / self.cell).astype(np.int64)
         ny, nx = self.grid.shape
-        ok = (ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny)
+        cell = (pts - self.lo) / self.cell
+        ok = np.isfinite(cell).all(axis=1)
+        ok[ok] = (cell[ok] >= 0).all(axis=1) & (cell[ok, 0] < nx) & (cell[ok, 1] < ny)
+        ij = np.floor(cell[ok]).astype(np.int64)
         out = np.zeros(pts.shape[0], dtype=bool)
-        out[ok] = self.grid[ij[ok, 1], ij[ok, 0]]
+        out[ok] = self.grid[ij[:, 1], ij[:, 0]]
         return out
 
 
@@ -490,7 +492,12 @@ def _bitten_ball(fi, face, rims, s: Samples, h: float, tol: float, size: float):
     beyond = 2.0 * radius * math.tan(min(far + math.radians(10.0), math.pi * 0.9) / 2.0)
 
     def inside(c: np.ndarray) -> np.ndarray:
-        return raster(c) | (np.linalg.norm(c, axis=1) > beyond)
+        # the map's centre of projection (the face's centre) maps to no point
+        return raster(c) | ~(np.linalg.norm(c, axis=1) <= beyond)
+
+    def onto(x: np.ndarray) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return bite(x)
 
     ball = cq.Solid.makeSphere(
         radius, cq.Vector(*centre), cq.Vector(*axis), angleDegrees1=-90, angleDegrees2=90
@@ -500,10 +507,10 @@ def _bitten_ball(fi, face, rims, s: Samples, h: float, tol: float, size: float):
     if not lattice_revolved_body(ball, laid, h, size):
         return None
     p3 = laid.points
-    keep = inside(bite(p3)) & (cKDTree(rim_pts).query(p3)[0] >= KEEP_OFF * h)
+    keep = inside(onto(p3)) & (cKDTree(rim_pts).query(p3)[0] >= KEEP_OFF * h)
     p3, rows = p3[keep], laid.line_id[keep]
     on = np.flatnonzero(_on_surface(face, s.points, tol))
-    drop = on[inside(bite(s.points[on])) & _off_rims(s, on, rim_pts, h)]
+    drop = on[inside(onto(s.points[on])) & _off_rims(s, on, rim_pts, h)]
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     s.replace(
         drop,
