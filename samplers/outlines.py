@@ -319,8 +319,11 @@ def _repair_in(
     near_rim = rims.distance(s.points) < ON_RIM * h
     on = _on_surface(face, s.points, tol)
     cand = np.flatnonzero(on | (near_rim & s.on_feature))
-    c = chart(s.points[cand])
-    mine = inside(c) | (near_rim[cand] & s.on_feature[cand])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = chart(s.points[cand])
+    # a sample at a map's centre of projection (a bitten ball's pole) has no
+    # place on it: it is far from the rims, and stays out of the repair
+    mine = (inside(c) | (near_rim[cand] & s.on_feature[cand])) & np.isfinite(c).all(axis=1)
     idx, c = cand[mine], c[mine]
     if idx.size == 0:
         return None

@@ -1588,3 +1588,22 @@ def test_a_ball_with_a_bite_is_laid_as_the_whole_ball():
     assert "sphere chart" in {x["kind"] for x in r.meta["repairs"]}
     assert distance_to_surface(r.points, s.truth_vertices, s.truth_triangles).max() < 0.05 * h
     assert (ratio >= 0.85).sum() <= 10
+
+
+@pytest.mark.slow
+def test_a_bitten_balls_pole_at_the_maps_centre_of_projection_is_left_out_of_the_repair():
+    """A ball with a box cut from its bottom: the face's centre is the ball's
+    top pole, where the bite's map projects from (it maps to no point).  The
+    ball's rings keep a sample there; taken into the rims' repair, its NaN
+    chart position made the repair's k-d tree fail ("data must be finite",
+    the stop 55 survey's crash).  It stays out of the repair, which runs."""
+    import cadquery as cq
+
+    ball = cq.Solid.makeSphere(0.4, angleDegrees1=-90, angleDegrees2=90)
+    box = cq.Solid.makeBox(0.5, 0.5, 0.3, pnt=cq.Vector(-0.25, -0.25, -0.55))
+    s = shapes.from_cad(cq.Solid(ball.cut(box).Solids()[0].wrapped), name="bitten ball")
+    r = scan(s, target_points=1500, quiet=True)
+    assert np.isfinite(r.points).all()
+    assert "sphere chart" in {x["kind"] for x in r.meta["repairs"]}
+    top = np.array([0.0, 0.0, 0.4])
+    assert np.linalg.norm(r.points - top, axis=1).min() < 1e-9  # the pole's sample stays
