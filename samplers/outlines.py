@@ -45,7 +45,7 @@ from scipy.spatial import cKDTree
 from sr33.mesh import dot, norm
 
 from .faces import RIM_SAMPLED, Stereographic, basis_surface, goes_round, steps, whole_band
-from .layers import POLE_GOOD, RASTER, STUCK, unstuck
+from .layers import POLE_GOOD, RASTER, STUCK, lattice_revolved_body, unstuck
 from .repair import repair
 from .samples import Samples
 from .spheres import FACING
@@ -470,8 +470,6 @@ def _bitten_ball(fi, face, rims, s: Samples, h: float, tol: float, size: float):
     centre, where the map's scale is at most 1 / cos²(BITE / 2)).  Returns
     the report, or None where the face is not of that kind."""
     import cadquery as cq
-
-    from .layers import lattice_revolved_body
 
     chart = _sphere_chart(face)
     if chart is None:
