@@ -88,7 +88,7 @@ def test_sampling_logs_every_step_at_debug_level(caplog):
     repairs = ["pyramids", "filleted boxes", "disks", "spherical caps", "developable bands"]
     repairs += ["planar faces"]
     repairs += ["planar faces along square edges", "cylinders", "cones"]
-    repairs += ["bodies of revolution", "partial spheres"]
+    repairs += ["bodies of revolution", "partial spheres", "curved faces in their charts"]
     assert steps == first + repairs + first
 
 
