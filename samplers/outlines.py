@@ -38,17 +38,20 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from sr33.mesh import dot, norm
+from sr33.mesh import dot
 
 from .faces import RIM_SAMPLED, Stereographic, basis_surface, goes_round, steps, whole_band
 from .layers import POLE_GOOD, RASTER, STUCK, lattice_revolved_body, unstuck
 from .repair import repair
 from .samples import Samples
-from .spheres import FACING
+from .spheres import FACING, face_pole
 
 RIM_STEP = 1.0 / 20.0  # rims as points this far apart (times h)
 LAYER = 3.0  # a developed face's samples this near a rim (times h) move
@@ -110,9 +113,14 @@ class Unrolled:
 
 
 class _Sphere(Stereographic):
-    """The stereographic map with its scale (chart length per length)."""
+    """The stereographic map with its scale (chart length per length); the
+    centre of projection maps to no point (NaN or inf), without a warning."""
 
     period = None
+
+    def __call__(self, p) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return super().__call__(p)
 
     def scale(self, c: np.ndarray) -> np.ndarray:
         return 1.0 + (c**2).sum(axis=1) / (2.0 * self.radius) ** 2
@@ -187,17 +195,24 @@ def _face_triangles(face, tol: float) -> np.ndarray:
     return v[t]
 
 
-class Rims:
-    """A face's rims (:func:`rim_edges`) as points ``RIM_STEP`` h apart:
-    ``p3`` in space, ``c`` in the chart, ``inward`` the unit direction into
-    the face there (in the chart)."""
+def rim_lines(edges, h: float) -> list[np.ndarray]:
+    """Each edge as points ``RIM_STEP`` h apart along it (in space)."""
+    out = []
+    for e in edges:
+        n = max(2, math.ceil(e.Length() / (RIM_STEP * h))) + 1
+        out.append(np.array([v.toTuple() for v in e.positions(np.linspace(0.0, 1.0, n))]))
+    return out
 
-    def __init__(self, edges, chart, inside, h: float):
-        p3, c, inward = [], [], []
+
+class Rims:
+    """A face's rims (:func:`rim_edges`), as points along them
+    (:func:`rim_lines`): ``p3`` in space, ``c`` in the chart, ``inward``
+    the unit direction into the face there (in the chart)."""
+
+    def __init__(self, lines: list[np.ndarray], chart, inside, h: float):
+        c, inward = [], []
         period = chart.period
-        for e in edges:
-            n = max(2, math.ceil(e.Length() / (RIM_STEP * h))) + 1
-            q = np.array([v.toTuple() for v in e.positions(np.linspace(0.0, 1.0, n))])
+        for q in lines:
             cq_ = chart(q)
             d = np.gradient(cq_, axis=0)
             if period is not None:  # across the cut, the short way
@@ -209,10 +224,9 @@ class Rims:
             # per point where the probes disagree, else the edge's majority
             sign = np.where(plus & ~minus, 1.0, np.where(minus & ~plus, -1.0, 0.0))
             sign[sign == 0] = 1.0 if (sign > 0).sum() >= (sign < 0).sum() else -1.0
-            p3.append(q)
             c.append(cq_)
             inward.append(sign[:, None] * nrm)
-        self.p3 = np.vstack(p3)
+        self.p3 = np.vstack(lines)
         self.c = np.vstack(c)
         self.inward = np.vstack(inward)
         self.tree3 = cKDTree(self.p3)
@@ -252,17 +266,31 @@ class Rims:
         return self.c[j] - (d * self.scale[j])[:, None] * self.inward[j]
 
 
-def _sphere_chart(face):
+@dataclass
+class _View:
+    """A face in one chart: its domain there (``inside``), its rims, and
+    the spacing its repair aims at there (``step``)."""
+
+    chart: Any
+    inside: Callable[[np.ndarray], np.ndarray]
+    rims: Rims
+    step: float
+
+
+def _view(chart, tri3: np.ndarray, lines, h: float, inside=None, step=None) -> _View:
+    """``chart``'s view of a face: its domain the face's tessellation
+    ``tri3`` filled in (unless ``inside`` is given), its rims ``lines``."""
+    if inside is None:
+        tri = chart(tri3.reshape(-1, 3)).reshape(-1, 3, 2)
+        inside = TriangleRaster(tri, h / RASTER, chart.period)
+    return _View(chart, inside, Rims(lines, chart, inside, h), h if step is None else step)
+
+
+def _sphere_chart(face) -> _Sphere | None:
     """A sphere face's stereographic map from the point opposite its
-    centre, or None where it reaches more than ``FACING`` round."""
-    sph = basis_surface(face).Sphere()
-    centre = np.array(sph.Location().Coord())
-    radius = float(sph.Radius())
-    pole = np.array(face.Center().toTuple()) - centre
-    if norm(pole) < 1e-9 * radius:
-        return None
-    pole /= norm(pole)
-    return _Sphere(centre, radius, pole)
+    centre (None where the face has no centre off the sphere's)."""
+    got = face_pole(face)
+    return None if got is None else _Sphere(*got)
 
 
 def _cylinder(face):
@@ -289,38 +317,16 @@ def _on_surface(face, points: np.ndarray, tol: float) -> np.ndarray:
     return np.abs(radial - radius) < tol
 
 
-def _repair_in(
-    fi,
-    face,
-    chart,
-    tri3,
-    rims_of,
-    s: Samples,
-    h,
-    tol,
-    movable,
-    good,
-    images,
-    inside=None,
-    step=None,
-):
-    """One repair of face ``fi`` in ``chart``: ``movable(c, d)`` says
-    which of its samples (at ``c`` in the chart, ``d`` from the rims in
-    space) may move; ``images`` whether its samples near the chart's cut
-    are imaged across it; ``inside`` the face's domain in the chart
-    (default: its tessellation ``tri3`` filled in); ``step`` the spacing the
-    repair aims at in the chart (default h).  Returns the report, or None
-    when nothing moves."""
-    if inside is None:
-        tri = chart(tri3.reshape(-1, 3)).reshape(-1, 3, 2)
-        inside = TriangleRaster(tri, h / RASTER, chart.period)
-    step = h if step is None else step
-    rims = Rims(rims_of, chart, inside, h)
+def _repair_in(fi, face, view: _View, s: Samples, h, tol, movable, good, images):
+    """One repair of face ``fi`` in ``view``: ``movable(c, d)`` says which
+    of its samples (at ``c`` in the chart, ``d`` from the rims in space)
+    may move; ``images`` whether its samples near the chart's cut are
+    imaged across it.  Returns the report, or None when nothing moves."""
+    chart, inside, rims = view.chart, view.inside, view.rims
     near_rim = rims.distance(s.points) < ON_RIM * h
     on = _on_surface(face, s.points, tol)
     cand = np.flatnonzero(on | (near_rim & s.on_feature))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        c = chart(s.points[cand])
+    c = chart(s.points[cand])
     # a sample at a map's centre of projection (a bitten ball's pole) has no
     # place on it: it is far from the rims, and stays out of the repair
     mine = (inside(c) | (near_rim[cand] & s.on_feature[cand])) & np.isfinite(c).all(axis=1)
@@ -346,6 +352,7 @@ def _repair_in(
         frame=np.vstack(frame),
         judge_frame=True,
     )
+    step = view.step
     r = unstuck(c, free, step, repair(c, free, step, **args), good, **args)
     pts3 = chart.inverse(r.uv)
     kept = r.origin >= 0
@@ -354,50 +361,66 @@ def _repair_in(
     return s.put(idx, r, pts3, fi, f"{face.geomType().lower()} chart")
 
 
-def _lay_lattice(fi, face, chart, tri3, rims_of, s: Samples, h: float, tol: float) -> None:
+def _relay(s: Samples, fi: int, idx, within, p3, keep, rows, rims: np.ndarray, h: float):
+    """Lay face ``fi`` out anew: its samples ``idx`` that lie in it
+    (``within``), but for those on its rims, give way to the laid points
+    ``p3`` that lie in it (``keep``) and ``KEEP_OFF`` h off its rims
+    (points ``rims``), each on the line ``rows`` after the last one."""
+    keep = keep.copy()
+    keep[keep] = cKDTree(rims).query(p3[keep])[0] >= KEEP_OFF * h
+    drop = idx[within & _off_rims(s, idx, rims, h)]
+    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
+    n = int(keep.sum())
+    s.replace(drop, p3[keep], line + rows[keep], np.full(n, fi), np.zeros(n, dtype=bool))
+
+
+def _lay_lattice(fi, face, view: _View, tri3, lines, s: Samples, h: float, tol: float) -> None:
     """Replace the face's samples off its rims by a square lattice of side
     h in the chart (rows along its first axis, one through the origin: its
     Delaunay triangles are right isosceles, ratio 1/√2 on the map), without
     the points nearer than ``KEEP_OFF`` h to a rim.  The chart's scale is
     at least 1 (1 at a stereographic map's centre), so the samples are at
     most h apart on the surface."""
-    tri = chart(tri3.reshape(-1, 3)).reshape(-1, 3, 2)
-    inside = TriangleRaster(tri, h / RASTER, chart.period)
-    on = np.flatnonzero(_on_surface(face, s.points, tol))
-    drop = on[inside(chart(s.points[on])) & _off_rims(s, on, rims_of, h)]
-    lo, hi = tri.reshape(-1, 2).min(axis=0), tri.reshape(-1, 2).max(axis=0)
+    chart, inside = view.chart, view.inside
+    tri = chart(tri3.reshape(-1, 3))
+    lo, hi = tri.min(axis=0), tri.max(axis=0)
     rows = np.arange(math.floor(lo[1] / h) - 1, math.ceil(hi[1] / h) + 2)
     cols = np.arange(math.floor(lo[0] / h) - 1, math.ceil(hi[0] / h) + 2)
     jj, ii = np.meshgrid(rows, cols, indexing="ij")
     c = np.stack([ii * h, jj * h], axis=-1).reshape(-1, 2).astype(np.float64)
-    row = jj.reshape(-1) - rows[0]
-    keep = inside(c)
-    c, row = c[keep], row[keep]
-    p3 = chart.inverse(c)
-    far = cKDTree(rims_of).query(p3)[0] >= KEEP_OFF * h
-    p3, row = p3[far], row[far]
-    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
-    s.replace(
-        drop,
-        p3,
-        line + row,
-        np.full(row.size, fi),
-        np.zeros(row.size, dtype=bool),
+    on = np.flatnonzero(_on_surface(face, s.points, tol))
+    _relay(
+        s,
+        fi,
+        on,
+        inside(chart(s.points[on])),
+        chart.inverse(c),
+        inside(c),
+        jj.reshape(-1) - rows[0],
+        np.vstack(lines),
+        h,
     )
 
 
-def _lay_cylinder(fi, face, rims_of, s: Samples, h: float, tol: float) -> None:
+def _cuts(face) -> list[float]:
+    """Where a cylinder face is unrolled from: going round, at its seam and
+    half a turn on; else in the middle of the missing turn."""
+    umin, umax, _, _ = face._uvBounds()
+    return [umin, umin + math.pi] if goes_round(face) else [0.5 * (umin + umax) + math.pi]
+
+
+def _lay_cylinder(fi, face, view: _View, lines, s: Samples, h: float, tol: float) -> None:
     """Replace a cylinder face's samples off its rims by the lattice its
-    unrolled chart carries: columns at the angles of the samples on a whole
-    circle round it (its lowest one, as :func:`sr33.samplers.layers.lattice_cylinder_faces`
-    takes a rim's), else evenly spaced (about h apart), and rows as far
-    apart as the columns from that circle (else from the face's lowest
-    point), so that the cells are squares; without the points nearer than
-    ``KEEP_OFF`` h to a rim."""
+    unrolled chart (``view``, from its first cut) carries: columns at the
+    angles of the samples on a whole circle round it (its lowest one, as
+    :func:`sr33.samplers.layers.lattice_cylinder_faces` takes a rim's), else
+    evenly spaced (about h apart), and rows as far apart as the columns
+    from that circle (else from the face's lowest point), so that the cells
+    are squares; without the points nearer than ``KEEP_OFF`` h to a rim."""
     o, ex, ey, ez, radius = _cylinder(face)
     umin, umax, vmin, vmax = face._uvBounds()
     round_ = goes_round(face)
-    chart = Unrolled(o, ex, ey, ez, radius, umin if round_ else 0.5 * (umin + umax) + math.pi)
+    chart = view.chart
     q = s.points - o
     axial = dot(q, ez)
     radial = np.linalg.norm(q - axial[:, None] * ez, axis=1)
@@ -405,7 +428,7 @@ def _lay_cylinder(fi, face, rims_of, s: Samples, h: float, tol: float) -> None:
     angles, z0 = None, vmin
     circles = [
         e
-        for e in rims_of
+        for e in rim_edges(face)
         if e.geomType() == "CIRCLE"
         and e.IsClosed()
         and abs(abs(dot(np.array(e.normal().toTuple()), ez)) - 1.0) < 1e-9
@@ -429,17 +452,19 @@ def _lay_cylinder(fi, face, rims_of, s: Samples, h: float, tol: float) -> None:
     z = z0 + k[k != 0] * gap
     z = z[(z > vmin) & (z < vmax)]
     zz, aa = np.repeat(z, angles.size), np.tile(angles, z.size)
-    row = np.repeat(np.arange(z.size), angles.size)
     p3 = o + zz[:, None] * ez + radius * (np.cos(aa)[:, None] * ex + np.sin(aa)[:, None] * ey)
-    tri = chart(_face_triangles(face, h / 20).reshape(-1, 3)).reshape(-1, 3, 2)
-    inside = TriangleRaster(tri, h / RASTER, chart.period)
-    rims_pts = rims_of_points(rims_of, h)
-    keep = inside(chart(p3)) & (cKDTree(rims_pts).query(p3)[0] >= KEEP_OFF * h)
-    p3, row = p3[keep], row[keep]
     idx = np.flatnonzero(on)
-    drop = idx[inside(chart(s.points[idx])) & _off_rims(s, idx, rims_pts, h)]
-    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
-    s.replace(drop, p3, line + row, np.full(row.size, fi), np.zeros(row.size, dtype=bool))
+    _relay(
+        s,
+        fi,
+        idx,
+        view.inside(chart(s.points[idx])),
+        p3,
+        view.inside(chart(p3)),
+        np.repeat(np.arange(z.size), angles.size),
+        np.vstack(lines),
+        h,
+    )
 
 
 def _off_rims(s: Samples, idx: np.ndarray, rims: np.ndarray, h: float) -> np.ndarray:
@@ -450,18 +475,10 @@ def _off_rims(s: Samples, idx: np.ndarray, rims: np.ndarray, h: float) -> np.nda
     return ~s.on_feature[idx] | far
 
 
-def rims_of_points(edges, h: float) -> np.ndarray:
-    """The edges as points ``RIM_STEP`` h apart (in space)."""
-    out = [np.empty((0, 3))]
-    for e in edges:
-        n = max(2, math.ceil(e.Length() / (RIM_STEP * h))) + 1
-        out.append(np.array([v.toTuple() for v in e.positions(np.linspace(0.0, 1.0, n))]))
-    return np.vstack(out)
-
-
-def _bitten_ball(fi, face, rims, s: Samples, h: float, tol: float, size: float):
-    """A sphere face too wide for one map (a ball with a bite taken out by
-    a box or another ball): laid as the whole ball is
+def _bitten_ball(fi, face, chart, tri3, lines, s: Samples, h: float, tol: float, size: float):
+    """A sphere face too wide for one map (``chart``, centred on the face;
+    ``tri3`` its tessellation, ``lines`` its rims): a ball with a bite
+    taken out by a box or another ball.  Laid as the whole ball is
     (:func:`sr33.samplers.layers.lattice_revolved_body`, rings with halving
     columns between two poles) about the axis through the face's centre,
     whose far pole lies in the bite, keeping the rings' samples on the face
@@ -471,16 +488,12 @@ def _bitten_ball(fi, face, rims, s: Samples, h: float, tol: float, size: float):
     the report, or None where the face is not of that kind."""
     import cadquery as cq
 
-    chart = _sphere_chart(face)
-    if chart is None:
-        return None
     centre, radius, axis = chart.centre, chart.radius, chart.pole
     bite = _Sphere(centre, radius, -axis)  # projected from the face's centre
-    rim_pts = rims_of_points(rims, h)
+    rim_pts = np.vstack(lines)
     rim_cos = dot(rim_pts - centre, -axis) / radius
     if rim_cos.min() <= math.cos(BITE):
         return None  # a rim far from the bite (two bites): not one map's
-    tri3 = _face_triangles(face, h / 20)
     # the bite's map, filled in as far as 20° past the farthest rim: beyond
     # 10° past it, all is the face (the map runs to infinity at its centre)
     far = math.acos(max(-1.0, rim_cos.min()))
@@ -496,10 +509,6 @@ def _bitten_ball(fi, face, rims, s: Samples, h: float, tol: float, size: float):
         # the map's centre of projection (the face's centre) maps to no point
         return raster(c) | ~(np.linalg.norm(c, axis=1) <= beyond)
 
-    def onto(x: np.ndarray) -> np.ndarray:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return bite(x)
-
     ball = cq.Solid.makeSphere(
         radius, cq.Vector(*centre), cq.Vector(*axis), angleDegrees1=-90, angleDegrees2=90
     )
@@ -507,35 +516,26 @@ def _bitten_ball(fi, face, rims, s: Samples, h: float, tol: float, size: float):
     laid = Samples(poles, np.full(2, -1), np.zeros(2, dtype=np.int64), np.ones(2, dtype=bool))
     if not lattice_revolved_body(ball, laid, h, size):
         return None
-    p3 = laid.points
-    keep = inside(onto(p3)) & (cKDTree(rim_pts).query(p3)[0] >= KEEP_OFF * h)
-    p3, rows = p3[keep], laid.line_id[keep]
     on = np.flatnonzero(_on_surface(face, s.points, tol))
-    drop = on[inside(onto(s.points[on])) & _off_rims(s, on, rim_pts, h)]
-    line = int(s.line_id.max()) + 1 if s.line_id.size else 0
-    s.replace(
-        drop,
-        p3,
-        line + np.maximum(rows, 0),
-        np.full(p3.shape[0], fi),
-        np.zeros(p3.shape[0], dtype=bool),
+    _relay(
+        s,
+        fi,
+        on,
+        inside(bite(s.points[on])),
+        laid.points,
+        inside(bite(laid.points)),
+        np.maximum(laid.line_id, 0),
+        rim_pts,
+        h,
     )
     scale = float(np.median(bite.scale(bite(rim_pts))))
-    return _repair_in(
-        fi,
-        face,
-        bite,
-        tri3,
-        rims,
-        s,
-        h,
-        tol,
-        lambda c, d: d < LAYER * h,
-        POLE_GOOD,
-        images=False,
-        inside=inside,
-        step=h * scale,
-    )
+    view = _view(bite, tri3, lines, h, inside=inside, step=h * scale)
+    return _repair_in(fi, face, view, s, h, tol, functools.partial(_layer, h=h), POLE_GOOD, False)
+
+
+def _layer(c: np.ndarray, d: np.ndarray, *, h: float) -> np.ndarray:
+    """The samples within ``LAYER`` h of a rim (``d``) move."""
+    return d < LAYER * h
 
 
 def _cut_pass(c: np.ndarray, d: np.ndarray, *, h: float, period: float, passes: int, k: int):
@@ -544,7 +544,7 @@ def _cut_pass(c: np.ndarray, d: np.ndarray, *, h: float, period: float, passes: 
     of a rim; with two passes, not within ``CUT_CLEAR`` h of the pass's
     cut, and in the second only those round the first pass's cut (half a
     turn on)."""
-    layer = d < LAYER * h
+    layer = _layer(c, d, h=h)
     if passes == 1:
         return layer
     away = np.minimum(c[:, 0], period - c[:, 0]) > CUT_CLEAR * h
@@ -602,68 +602,46 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
         if cKDTree(feature).query(mids)[0].max() > RIM_SAMPLED * h:
             continue  # a smooth edge: the face blends into its neighbour
         if kind == "SPHERE":
-            spheres.append((fi, face, rims))
+            spheres.append((fi, face, rim_lines(rims, h)))
         elif not whole_band(face):
-            cylinders.append((fi, face, rims))
-    charts, wide = {}, []
-    for fi, face, rims in spheres:
+            cylinders.append((fi, face, rim_lines(rims, h)))
+    views: dict[int, list[_View]] = {}  # per face, its chart (a cylinder's: per cut)
+    wide = []
+    for fi, face, lines in spheres:
         chart = _sphere_chart(face)
         if chart is None:
             continue
         tri3 = _face_triangles(face, h / 20)
         if dot(tri3.reshape(-1, 3) - chart.centre, chart.pole).min() <= REACH * chart.radius:
-            wide.append((fi, face, rims))  # too far round for one map
+            wide.append((fi, face, chart, tri3, lines))  # too far round for one map
             continue
-        charts[fi] = (chart, tri3)
-        _lay_lattice(fi, face, chart, tri3, rims_of_points(rims, h), s, h, tol)
-    for fi, face, rims in cylinders:
-        _lay_cylinder(fi, face, rims, s, h, tol)
-    for fi, face, rims in wide:
-        rep = _bitten_ball(fi, face, rims, s, h, tol, size)
+        views[fi] = [_view(chart, tri3, lines, h)]
+        _lay_lattice(fi, face, views[fi][0], tri3, lines, s, h, tol)
+    for fi, face, lines in cylinders:
+        o, ex, ey, ez, radius = _cylinder(face)
+        tri3 = _face_triangles(face, h / 20)
+        views[fi] = [
+            _view(Unrolled(o, ex, ey, ez, radius, cut), tri3, lines, h) for cut in _cuts(face)
+        ]
+        _lay_cylinder(fi, face, views[fi][0], lines, s, h, tol)
+    for fi, face, chart, tri3, lines in wide:
+        rep = _bitten_ball(fi, face, chart, tri3, lines, s, h, tol, size)
         if rep is not None:
             reports.append(rep)
+    layer = functools.partial(_layer, h=h)
     for _ in range(ROUNDS):
-        for fi, face, rims in spheres:
-            if fi not in charts:
-                continue
-            chart, tri3 = charts[fi]
-            rep = _repair_in(
-                fi,
-                face,
-                chart,
-                tri3,
-                rims,
-                s,
-                h,
-                tol,
-                lambda c, d: d < LAYER * h,
-                POLE_GOOD,
-                images=False,
-            )
-            if rep is not None:
-                reports.append(rep)
-        for fi, face, rims in cylinders:
-            o, ex, ey, ez, radius = _cylinder(face)
-            tri3 = _face_triangles(face, h / 20)
-            umin, umax, _, _ = face._uvBounds()
-            # a face going round: cut where its seam is, then half a turn on;
-            # else in the middle of the missing turn
-            cuts = [umin, umin + math.pi] if goes_round(face) else [0.5 * (umin + umax) + math.pi]
-            for k, cut in enumerate(cuts):
-                chart = Unrolled(o, ex, ey, ez, radius, cut)
-                rep = _repair_in(
-                    fi,
-                    face,
-                    chart,
-                    tri3,
-                    rims,
-                    s,
-                    h,
-                    tol,
-                    functools.partial(_cut_pass, h=h, period=chart.period, passes=len(cuts), k=k),
-                    STUCK,
-                    images=len(cuts) > 1,
+        for fi, face, _ in spheres:
+            if fi in views:
+                rep = _repair_in(fi, face, views[fi][0], s, h, tol, layer, POLE_GOOD, False)
+                if rep is not None:
+                    reports.append(rep)
+        for fi, face, _ in cylinders:
+            passes = len(views[fi])
+            for k, view in enumerate(views[fi]):
+                move = functools.partial(
+                    _cut_pass, h=h, period=view.chart.period, passes=passes, k=k
                 )
+                rep = _repair_in(fi, face, view, s, h, tol, move, STUCK, passes > 1)
                 if rep is not None:
                     reports.append(rep)
     return reports

@@ -111,6 +111,19 @@ def _rim_frame(face, arcs, sides, to2d: Stereographic, s: Samples, own, h: float
     return np.vstack(out)
 
 
+def face_pole(face) -> tuple[np.ndarray, float, np.ndarray] | None:
+    """A sphere face's centre, radius and the unit direction from the
+    centre to the face's own centre (its mass centre), or None where the
+    two coincide (a whole ball)."""
+    sph = basis_surface(face).Sphere()
+    centre = np.array(sph.Location().Coord())
+    radius = float(sph.Radius())
+    pole = np.array(face.Center().toTuple()) - centre
+    if norm(pole) < 1e-9 * radius:
+        return None
+    return centre, radius, pole / norm(pole)
+
+
 def repair_sphere_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     """Repair every partial sphere whose rims are all sampled (sharp edges).
 
@@ -170,13 +183,10 @@ def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=N
     sample is free)."""
     tol = 1e-7 * size
     fixed = s.on_feature if fixed is None else np.asarray(fixed, dtype=bool)
-    sph = basis_surface(face).Sphere()
-    centre = np.array(sph.Location().Coord())
-    radius = float(sph.Radius())
-    pole = np.array(face.Center().toTuple()) - centre
-    if norm(pole) < 1e-9 * radius:
+    got = face_pole(face)
+    if got is None:
         return None
-    pole /= norm(pole)
+    centre, radius, pole = got
     verts, _ = face.tessellate(h / 20, 0.3)
     reach = dot(np.array([v.toTuple() for v in verts]) - centre, pole)
     if reach.min() <= FACING * radius:

@@ -141,11 +141,14 @@ def _longest_edge(v: np.ndarray, t: np.ndarray) -> float:
     return float(np.sqrt(((p - p[:, [1, 2, 0]]) ** 2).sum(axis=2)).max())
 
 
-def _nearest_triangles(p, v, t, inc, tree, kk: int):
+def _nearest_triangles(p, v, t, inc, kk: int):
     """Per point, the nearest of the triangles round its ``kk`` nearest
-    vertices: triangle, barycentric coordinates, distance."""
+    vertices (``inc``: vertex-triangle incidence): triangle, barycentric
+    coordinates, distance."""
+    from scipy.spatial import cKDTree
+
     kk = min(kk, v.shape[0])
-    _, near = tree.query(p, kk)
+    _, near = cKDTree(v).query(p, kk)
     near = near.reshape(p.shape[0], kk)
     # candidate triangles: those around the kk nearest vertices (padded with -1)
     deg = np.diff(inc.indptr)
@@ -221,8 +224,7 @@ def insert_points(vertices, triangles, points, *, candidates: int = 4):
         inc = sparse.csr_matrix(
             (np.ones(t.size), (t.ravel(), np.repeat(np.arange(t.shape[0]), 3))), (nv, t.shape[0])
         )
-        tree = cKDTree(v)
-        best_tri, best_bary, best_d = _nearest_triangles(pts[pending], v, t, inc, tree, candidates)
+        best_tri, best_bary, best_d = _nearest_triangles(pts[pending], v, t, inc, candidates)
         # the triangles round a few nearest vertices can miss the point's
         # own (a ball's dish meeting a cylinder's wall at a sharp rim: the 4
         # nearest vertices were the wall's, and a dish sample split a wall
