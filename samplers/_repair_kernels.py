@@ -250,3 +250,153 @@ def energy_terms(
             gp[b, d] += f * (pts[b, d] - cen) / r
             gp[c, d] += f * (pts[c, d] - cen) / r
     return energy, gp, rho, rows
+
+
+@njit(cache=True)
+def delaunay_flips(pts, tri, nbr, tol_area, tol_circle):
+    """The Delaunay triangulation of ``pts`` from ``tri``, a triangulation of
+    the same points at earlier positions (counter-clockwise triangles, their
+    neighbours ``nbr`` opposite each corner, -1 on the hull), by Lawson's
+    edge flips; or None where flips cannot make it (the positions must be
+    tiled by the triangles as they are: every triangle counter-clockwise
+    with twice its area above ``tol_area``, every vertex's angles adding up
+    to 2π inside and at most π on the hull).
+
+    An edge is flipped when its neighbour's far corner lies inside a
+    triangle's circumcircle by more than ``tol_circle`` (the in-circle
+    determinant), so that cocircular points (a lattice's squares, within
+    rounding) keep the diagonal they have.  Returns new arrays (the input
+    is left as it is) and the number of flips.  A repair step moves the
+    samples by 0.02 h: a few edges flip where a Qhull call would triangulate
+    them all anew.
+    """
+    n = pts.shape[0]
+    m = tri.shape[0]
+    angle = np.zeros(n)
+    hull = np.zeros(n, dtype=np.bool_)
+    for t in range(m):
+        for k in range(3):
+            a = tri[t, k]
+            b = tri[t, (k + 1) % 3]
+            c = tri[t, (k + 2) % 3]
+            ux = pts[b, 0] - pts[a, 0]
+            uy = pts[b, 1] - pts[a, 1]
+            vx = pts[c, 0] - pts[a, 0]
+            vy = pts[c, 1] - pts[a, 1]
+            cross = ux * vy - uy * vx
+            if cross <= tol_area:
+                return None
+            angle[a] += np.arctan2(cross, ux * vx + uy * vy)
+            if nbr[t, k] < 0:
+                hull[b] = True
+                hull[c] = True
+    for v in range(n):
+        if hull[v]:
+            # (a hull vertex between collinear ones has π, within rounding)
+            if angle[v] > np.pi + 1e-10:
+                return None
+        elif abs(angle[v] - 2.0 * np.pi) > 1e-6:
+            return None
+    tri = tri.copy()
+    nbr = nbr.copy()
+    stack_t = np.empty(3 * m + 64, dtype=np.int64)
+    stack_k = np.empty(3 * m + 64, dtype=np.int64)
+    top = 0
+    for t in range(m):
+        for k in range(3):
+            if nbr[t, k] > t:
+                stack_t[top] = t
+                stack_k[top] = k
+                top += 1
+    flips = 0
+    while top > 0:
+        top -= 1
+        t = stack_t[top]
+        k = stack_k[top]
+        u = nbr[t, k]
+        if u < 0:
+            continue
+        a = tri[t, k]
+        b = tri[t, (k + 1) % 3]
+        c = tri[t, (k + 2) % 3]
+        j = 0
+        while tri[u, j] == b or tri[u, j] == c:
+            j += 1
+        d = tri[u, j]  # u is (d, c, b) counter-clockwise from j
+        if _incircle(pts, a, b, c, d) <= tol_circle:
+            continue
+        nt_b = nbr[t, (k + 1) % 3]  # across (c, a)
+        nt_c = nbr[t, (k + 2) % 3]  # across (a, b)
+        nu_c = nbr[u, (j + 1) % 3]  # across (b, d)
+        nu_b = nbr[u, (j + 2) % 3]  # across (d, c)
+        # t becomes (a, b, d), u becomes (a, d, c)
+        tri[t, 0], tri[t, 1], tri[t, 2] = a, b, d
+        nbr[t, 0], nbr[t, 1], nbr[t, 2] = nu_c, u, nt_c
+        tri[u, 0], tri[u, 1], tri[u, 2] = a, d, c
+        nbr[u, 0], nbr[u, 1], nbr[u, 2] = nu_b, nt_b, t
+        for w, old, new in ((nu_c, u, t), (nt_b, t, u)):
+            if w >= 0:
+                for q in range(3):
+                    if nbr[w, q] == old:
+                        nbr[w, q] = new
+        flips += 1
+        if flips > 4 * m or top + 4 > stack_t.size:
+            return None
+        # the four outer edges may have stopped being Delaunay
+        stack_t[top], stack_k[top] = t, 0
+        stack_t[top + 1], stack_k[top + 1] = t, 2
+        stack_t[top + 2], stack_k[top + 2] = u, 0
+        stack_t[top + 3], stack_k[top + 3] = u, 1
+        top += 4
+    return tri, nbr, flips
+
+
+@njit(cache=True)
+def canonical_order(tri, nbr):
+    """Counter-clockwise triangles ``tri`` in one order whatever the
+    triangulator's: each turned to start at its smallest corner, the rows
+    sorted; with their neighbours ``nbr`` (opposite each corner, -1 on the
+    hull) turned and renumbered alike.  Returns new arrays."""
+    m = tri.shape[0]
+    t2 = np.empty_like(tri)
+    n2 = np.empty_like(nbr)
+    key = np.empty(m, dtype=np.int64)
+    big = np.int64(tri.max() + 1) if m else np.int64(1)
+    for t in range(m):
+        r = 0
+        if tri[t, 1] < tri[t, r]:
+            r = 1
+        if tri[t, 2] < tri[t, r]:
+            r = 2
+        for k in range(3):
+            t2[t, k] = tri[t, (r + k) % 3]
+            n2[t, k] = nbr[t, (r + k) % 3]
+        key[t] = (t2[t, 0] * big + t2[t, 1]) * big + t2[t, 2]
+    order = np.argsort(key)
+    back = np.empty(m, dtype=np.int64)
+    for i in range(m):
+        back[order[i]] = i
+    out_t = np.empty_like(tri)
+    out_n = np.empty_like(nbr)
+    for i in range(m):
+        for k in range(3):
+            out_t[i, k] = t2[order[i], k]
+            w = n2[order[i], k]
+            out_n[i, k] = back[w] if w >= 0 else -1
+    return out_t, out_n
+
+
+@njit(cache=True)
+def _incircle(pts, a, b, c, d):
+    """Positive when ``d`` lies inside the circle through the counter-clockwise ``a, b, c``."""
+    adx = pts[a, 0] - pts[d, 0]
+    ady = pts[a, 1] - pts[d, 1]
+    bdx = pts[b, 0] - pts[d, 0]
+    bdy = pts[b, 1] - pts[d, 1]
+    cdx = pts[c, 0] - pts[d, 0]
+    cdy = pts[c, 1] - pts[d, 1]
+    return (
+        (adx * adx + ady * ady) * (bdx * cdy - cdx * bdy)
+        - (bdx * bdx + bdy * bdy) * (adx * cdy - cdx * ady)
+        + (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady)
+    )

@@ -111,3 +111,67 @@ def test_the_gradient_is_the_energys_derivative_and_the_radius_term_pulls_inward
     e, g, _, _ = energy_terms(wide, np.arange(3), *args[:1], three, ~three, *args[3:], 1.0)
     assert e > 0.0
     assert ((g * (wide - wide.mean(axis=0))).sum(axis=1) > 0).all()  # descent moves inwards
+
+
+def _canonical_delaunay(pts):
+    from sr33.samplers.repair import canonical_triangles
+
+    d = Delaunay(pts)
+    tri, nbr, _ = canonical_triangles(pts, d.simplices, d.neighbors)
+    return tri, nbr
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1), side=st.integers(3, 14), move=st.sampled_from([0.01, 0.05, 0.2])
+)
+def test_flips_from_the_last_triangulation_give_qhulls_triangles(seed, side, move):
+    """Lawson's flips from the triangles of the points' last positions end at
+    the Delaunay triangles Qhull gives for the new ones (the same rows, the
+    same neighbours, in canonical order), or give up (None): never another
+    triangulation."""
+    from sr33.samplers._repair_kernels import canonical_order, delaunay_flips
+
+    rng = np.random.default_rng(seed)
+    g = np.stack(np.meshgrid(np.arange(side), np.arange(side)), -1).reshape(-1, 2).astype(float)
+    before = g + rng.uniform(-0.3, 0.3, g.shape)
+    inner = ((g > 0) & (g < side - 1)).all(axis=1)  # the hull's points stay
+    after = before.copy()
+    after[inner] += rng.uniform(-move, move, (int(inner.sum()), 2))
+    tri, nbr = _canonical_delaunay(before)
+    out = delaunay_flips(after, tri, nbr, 1e-9, 1e-10)
+    if move <= 0.05:  # no triangle can turn over: flips always do it
+        assert out is not None
+    if out is not None:
+        got_t, got_n = canonical_order(out[0], out[1])
+        want_t, want_n = _canonical_delaunay(after)
+        np.testing.assert_array_equal(got_t, want_t)
+        np.testing.assert_array_equal(got_n, want_n)
+    np.testing.assert_array_equal(tri, _canonical_delaunay(before)[0])  # input left alone
+
+
+def test_flips_give_up_on_a_turned_over_triangle_and_keep_a_squares_diagonal():
+    from sr33.samplers._repair_kernels import delaunay_flips
+
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    tri, nbr = _canonical_delaunay(square)
+    # cocircular: both diagonals are Delaunay, the one there stays (no flip)
+    out = delaunay_flips(square + 1e-13, tri, nbr, 1e-9, 1e-10)
+    assert out is not None and out[2] == 0
+    np.testing.assert_array_equal(out[0], tri)
+    # a corner pulled in past the circle: one flip to the other diagonal
+    kite = square.copy()
+    diagonal = set(tri[0]) & set(tri[1])
+    far = ({0, 1, 2, 3} - diagonal).pop()
+    kite[far] += 0.2 * (np.array([0.5, 0.5]) - kite[far])
+    out = delaunay_flips(kite, tri, nbr, 1e-9, 1e-10)
+    assert out is not None and out[2] == 1
+    assert set(out[0][0]) & set(out[0][1]) == {0, 1, 2, 3} - diagonal
+    # a corner pushed across the diagonal turns a triangle over: no answer
+    crossed = square.copy()
+    crossed[far] = (
+        1.2 * (np.array([0.5, 0.5]) - crossed[far])
+        + crossed[far]
+        + (np.array([0.5, 0.5]) - crossed[far])
+    )
+    assert delaunay_flips(crossed, tri, nbr, 1e-9, 1e-10) is None
