@@ -400,3 +400,17 @@ def _incircle(pts, a, b, c, d):
         - (bdx * bdx + bdy * bdy) * (adx * cdy - cdx * ady)
         + (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady)
     )
+
+
+@njit(cache=True)
+def same_points(of_before, of, before, pts, reach):
+    """Whether ``pts`` are the points ``before`` moved: the same ids ``of``,
+    none farther than ``reach``."""
+    if of_before.shape[0] != of.shape[0]:
+        return False
+    for i in range(of.shape[0]):
+        if of_before[i] != of[i]:
+            return False
+        if abs(before[i, 0] - pts[i, 0]) > reach or abs(before[i, 1] - pts[i, 1]) > reach:
+            return False
+    return True

@@ -30,6 +30,7 @@ from scipy.spatial import Delaunay, cKDTree
 
 from sr33.mesh import SQRT3_2, dot, norm, triangle_ratios
 
+from . import _line_kernels as line_kernels
 from .adjacency import EdgeFaces
 from .chart import (
     Arc,
@@ -120,6 +121,13 @@ def _project_onto(curves: list, margin: float):
     # a line's ends are kept ``margin`` away: its parameter within [m, 1 - m]
     m = margin / np.sqrt(edges.dd)
 
+    if len(both.lines) == len(curves):  # straight edges only: one kernel
+
+        def project_lines(p: np.ndarray) -> np.ndarray:
+            return line_kernels.project(_points(p), edges.a, edges.d, edges.dd, m)
+
+        return project_lines
+
     def project(p: np.ndarray) -> np.ndarray:
         which = np.argmin(both.distances(p), axis=1)
         out = p.copy()
@@ -208,14 +216,10 @@ def _line_ghosts(lines: list[_Line], h: float):
         [end - j * h * ln.inward for ln in lines for end in (ln.a, ln.b) for j in (1.0, 2.0)]
     )
     edges = _Edges(lines)
+    inward = np.array([ln.inward for ln in lines], dtype=np.float64).reshape(-1, 2)
 
     def ghosts(p: np.ndarray) -> np.ndarray:
-        out = [corners]
-        on = edges.distance(p) < 1e-6 * h
-        for k, ln in enumerate(lines):
-            q = p[on[:, k]]
-            out += [q - j * h * ln.inward for j in (1.0, 2.0)]
-        return np.vstack(out)
+        return line_kernels.ghosts(_points(p), edges.a, edges.d, edges.dd, inward, h, corners)
 
     return ghosts
 
@@ -284,13 +288,16 @@ class _Edges:
 
     def along(self, p: np.ndarray) -> np.ndarray:
         """(n, m): every point's foot parameter on every edge."""
-        return dot(p[:, None, :] - self.a[None], self.d[None]) / self.dd[None]
+        return line_kernels.along(_points(p), self.a, self.d, self.dd)
 
     def distance(self, p: np.ndarray) -> np.ndarray:
         """(n, m): every point's distance to every edge."""
-        t = np.clip(self.along(p), 0.0, 1.0)
-        q = p[:, None, :] - (self.a[None] + t[:, :, None] * self.d[None])
-        return np.sqrt((q * q).sum(axis=-1))
+        return line_kernels.distance(_points(p), self.a, self.d, self.dd)
+
+
+def _points(p) -> np.ndarray:
+    """``p`` as a C-contiguous (n, 2) float64 array (the kernels' input)."""
+    return np.ascontiguousarray(np.asarray(p, dtype=np.float64).reshape(-1, 2))
 
 
 class _Curves:
@@ -481,20 +488,11 @@ def _clamp_lines(lines: list[_Line], h: float, margin: float = 0.4):
     edges = _Edges(lines)
     normals = np.array([ln.inward for ln in lines], dtype=np.float64).reshape(-1, 2)
 
-    def measure(q: np.ndarray):
-        return edges.along(q), dot(q[:, None, :] - edges.a[None], normals[None])
-
     def clamp(p: np.ndarray) -> np.ndarray:
         # edge by edge, each seeing the points the ones before it moved
-        out = p.copy()
-        t_all, in_all = measure(out)
-        for k, ln in enumerate(lines):
-            t, inward = t_all[:, k], in_all[:, k]
-            bad = (t > 0) & (t < 1) & (inward < margin * h) & (inward > -2 * h)
-            if bad.any():
-                out[bad] += (margin * h - inward[bad])[:, None] * ln.inward
-                t_all[bad], in_all[bad] = measure(out[bad])
-        return out
+        return line_kernels.clamp(
+            _points(p), edges.a, edges.d, edges.dd, normals, margin * h, -2 * h
+        )
 
     return clamp
 

@@ -52,7 +52,7 @@ from scipy.spatial import Delaunay, QhullError, cKDTree
 from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
 
-from ._repair_kernels import canonical_order, delaunay_flips, energy_terms
+from ._repair_kernels import canonical_order, delaunay_flips, energy_terms, same_points
 
 TARGET = 0.78  # the descent pushes every ratio below this
 BAD = 0.83  # a triangle above this still needs work (margin below sqrt(3)/2)
@@ -317,12 +317,7 @@ def _delaunay(prob: _Problem, pts: np.ndarray, of: np.ndarray) -> np.ndarray:
     """
     h = prob.h
     last = prob.delaunay
-    if (
-        last is not None
-        and last[0].shape == of.shape
-        and np.array_equal(last[0], of)
-        and np.abs(last[1] - pts).max() <= KEEP_MOVE * h
-    ):
+    if last is not None and same_points(last[0], of, last[1], pts, KEEP_MOVE * h):
         flipped = delaunay_flips(pts, last[2], last[3], KEEP_AREA * h * h, KEEP_CIRCLE * h**4)
         if flipped is not None:
             tri, nbr, flips = flipped

@@ -284,3 +284,33 @@ def naive_repair_energy(
         axis=1,
     )
     return energy, gp, rho, tri
+
+
+def naive_line_clamp(p, a, d, normals, least, beyond):
+    """The straight edges' clamp as numpy (the code the kernel replaced)."""
+    dd = (d * d).sum(axis=-1)
+
+    def measure(q):
+        u = q[:, None, :] - a[None]
+        return (u * d[None]).sum(axis=-1) / dd[None], (u * normals[None]).sum(axis=-1)
+
+    out = p.copy()
+    t_all, in_all = measure(out)
+    for k in range(a.shape[0]):
+        t, inward = t_all[:, k], in_all[:, k]
+        bad = (t > 0) & (t < 1) & (inward < least) & (inward > beyond)
+        if bad.any():
+            out[bad] += (least - inward[bad])[:, None] * normals[k]
+            t_all[bad], in_all[bad] = measure(out[bad])
+    return out
+
+
+def naive_line_project(p, a, d, lo):
+    """Nearest point of the nearest straight edge, as numpy (the code the kernel replaced)."""
+    dd = (d * d).sum(axis=-1)
+    t = np.clip(((p[:, None, :] - a[None]) * d[None]).sum(axis=-1) / dd[None], 0.0, 1.0)
+    q = p[:, None, :] - (a[None] + t[:, :, None] * d[None])
+    which = np.argmin(np.sqrt((q * q).sum(axis=-1)), axis=1)
+    s = ((p - a[which]) * d[which]).sum(axis=-1) / dd[which]
+    s = np.clip(s, lo[which], 1.0 - lo[which])
+    return a[which] + s[:, None] * d[which]

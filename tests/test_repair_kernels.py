@@ -175,3 +175,27 @@ def test_flips_give_up_on_a_turned_over_triangle_and_keep_a_squares_diagonal():
         + (np.array([0.5, 0.5]) - crossed[far])
     )
     assert delaunay_flips(crossed, tri, nbr, 1e-9, 1e-10) is None
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(0, 60), m=st.integers(1, 8))
+def test_the_straight_edges_kernels_are_the_numpy_code_bit_for_bit(seed, n, m):
+    """The clamp and the projection of a planar face's straight edges (called
+    at every descent step) give the numpy code's bits: a sampling must not
+    move when they get faster."""
+    from sr33.samplers import _line_kernels as lk
+    from tests.naive import naive_line_clamp, naive_line_project
+
+    rng = np.random.default_rng(seed)
+    a = rng.uniform(-1, 1, (m, 2))
+    d = rng.uniform(-1, 1, (m, 2))
+    normals = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1)[:, None]
+    p = rng.uniform(-1.5, 1.5, (n, 2))
+    p[: n // 3] = a[rng.integers(0, m, n // 3)] + rng.random((n // 3, 1)) * d[:1]  # on edges
+    dd = (d * d).sum(axis=-1)
+    got = lk.clamp(p, a, d, dd, normals, 0.04, -0.2)
+    assert got.tobytes() == naive_line_clamp(p, a, d, normals, 0.04, -0.2).tobytes()
+    lo = rng.uniform(0.0, 0.2, m)
+    assert lk.project(p, a, d, dd, lo).tobytes() == naive_line_project(p, a, d, lo).tobytes()
+    t = ((p[:, None, :] - a[None]) * d[None]).sum(axis=-1) / dd[None]
+    assert lk.along(p, a, d, dd).tobytes() == t.tobytes()
