@@ -491,6 +491,8 @@ def repair(
     descent_steps: int = 300,
     max_edits: int | None = None,
     retry_bad: int = RETRY_BAD,
+    retry_worst: float = SQRT3_2,
+    shakes_from: int = 1,
 ) -> Repaired:
     """Move, remove or add samples until Condition III-ii holds with a margin.
 
@@ -552,6 +554,12 @@ def repair(
         default, ``RETRY_BAD``, trusts a few bad triangles to be the chart's
         error; a face whose judged triangles are all exact (every edge a
         straight line, its neighbours planar and unfolded) passes 1.
+    retry_worst : float
+        ... and with its worst ratio at or above this (by default √3/2: a
+        triangle breaking III-ii).
+    shakes_from : int
+        The further attempts' seeds are ``shakes_from`` on (a repair run
+        again after its attempts failed passes ``ATTEMPTS``: new shakes).
 
     Returns
     -------
@@ -602,8 +610,10 @@ def repair(
     searching = descent_steps > 0 or max_edits > 0
     start = prob.copy() if searching else prob
     prob, nbad, worst = _search(prob, descent_steps, max_edits)
-    if searching and worst >= SQRT3_2 and nbad >= retry_bad:
-        prob, nbad, worst = _attempts(start, (prob, nbad, worst), descent_steps, max_edits)
+    if searching and worst >= retry_worst and nbad >= retry_bad:
+        prob, nbad, worst = _attempts(
+            start, (prob, nbad, worst), descent_steps, max_edits, shakes_from
+        )
     # put the frame back among the untouched samples
     rest = np.setdiff1d(np.arange(n), sub)
     origin = np.where(prob.origin >= 0, sub[np.maximum(prob.origin, 0)], -1)
@@ -663,19 +673,20 @@ def _rank(answer) -> tuple:
     return (True, w, nbad) if worst >= SQRT3_2 else (False, nbad, w)
 
 
-def _attempts(start: _Problem, first, descent_steps: int, max_edits: int):
+def _attempts(start: _Problem, first, descent_steps: int, max_edits: int, shakes_from: int = 1):
     """Further attempts after a first one was left stuck (a triangle
     breaking III-ii and ``RETRY_BAD`` or more above the margin): the
     descent and the edits are a local search whose end depends on its path
     (the last bits of the input can decide it), so the search starts again
-    from the input with its free samples shaken by seeded offsets (attempt
-    a: up to 0.03 a h, uniform in a square), each
+    from the input with its free samples shaken by seeded offsets (seed
+    a from ``shakes_from`` on: up to 0.03 h times 1 to 5 in turn, uniform
+    in a square), each
     ending after ``STALL`` edits without progress.  The best answer by
     :func:`_rank` is kept, the input itself among them (never worse than
     it), and the attempts end once one is below ``GOOD_ENOUGH``."""
     nbad, _, _, worst = _status(start)
     best = min((first, (start, nbad, worst)), key=_rank)
-    for attempt in range(1, ATTEMPTS):
+    for attempt in range(shakes_from, shakes_from + ATTEMPTS - 1):
         if best[2] < GOOD_ENOUGH:
             break
         trial = start.copy()
@@ -694,10 +705,11 @@ def _attempts(start: _Problem, first, descent_steps: int, max_edits: int):
 
 def _shake(prob: _Problem, attempt: int) -> None:
     """Move the free samples by the seeded offsets of ``attempt`` (uniform in
-    a square of half-side 0.03 ``attempt`` h: the same on every machine)."""
+    a square of half-side 0.03 h times 1 to 5, ``attempt`` modulo 5: the
+    same on every machine)."""
     rng = np.random.default_rng(attempt)
     free = np.flatnonzero(prob.free)
-    size = 0.03 * attempt * prob.h
+    size = 0.03 * ((attempt - 1) % 5 + 1) * prob.h
     prob.uv[free] += (rng.random((free.size, 2)) * 2.0 - 1.0) * size
     if prob.clamp is not None and free.size:
         prob.uv[free] = prob.clamp(prob.uv[free])
@@ -811,6 +823,8 @@ def _corner_wedge(r: Repaired, fixed: np.ndarray, inside) -> tuple[int, np.ndarr
             if fixed[v]:
                 a, b = r.uv[tri[t, (k + 1) % 3]] - r.uv[v], r.uv[tri[t, (k + 2) % 3]] - r.uv[v]
                 half = a / norm(a) + b / norm(b)
+                if norm(half) < 1e-9:  # a flat angle (a sliver on a straight edge): no bisector
+                    continue
                 return v, half / norm(half)
     return None
 
