@@ -573,13 +573,19 @@ def repair_planar_faces(
     prism's two ends; their sides' columns run straight from one to the
     other).  A face still left with at most ``FEW_BAD`` triangles at or
     above ``STUCK`` is repaired again from that answer, round after round
-    while it stays stuck, at most ``again`` rounds (fillet_box's bottom: two
+    while it stays stuck and the round before moved a sample (else the next
+    would repeat it: conebox turned b ran 13 identical rounds), at most
+    ``again`` rounds (fillet_box's bottom: two
     of 0.884 where its corners' arcs meet the rows, none after the second
     run; conebox's top, round its cone's rim: 0.853 first, 0.842 after the
     eleventh).  Returns one report per repaired face.
     """
     reports = []
     done: dict[tuple, object] = {}
+    # a further round that leaves every sample where it was would be repeated
+    # as it is by the next (the same input): the rounds end there
+    further = walls is not None
+    entry = s.points.copy() if further else None
     # a full cylinder's first rim laid: its samples (3-D); a face repaired
     # again gets the rims laid in the first round
     walls = {} if walls is None else walls
@@ -758,7 +764,8 @@ def repair_planar_faces(
                 walls[a.wall] = pts3[a.distance(r.uv) < tol]
     _follow_columns(s, shifts, faces, tol)
     stuck = {x["face"] for x in reports if x["worst"] >= STUCK and x["bad"] <= FEW_BAD}
-    if again > 0 and stuck:
+    unchanged = further and entry.shape == s.points.shape and np.array_equal(entry, s.points)
+    if again > 0 and stuck and not unchanged:
         rest = set(range(len(faces))) - stuck
         redone = {
             x["face"]: x

@@ -398,3 +398,42 @@ def test_a_developments_images_fill_the_wedge_outside_it_once(degrees):
         on = np.isclose(r, ring)
         gaps = np.diff(np.sort(np.r_[ang[on], theta, 2 * math.pi]))
         assert gaps.max() * ring < 2.2
+
+
+def test_a_face_still_stuck_gets_new_shaken_starts_kept_only_when_better_on_both_counts(
+    monkeypatch,
+):
+    """unstuck's last step: a face still stuck after the corner splits is
+    repaired again from shaken starts with new seeds (``shakes_from``), and
+    that answer replaces the one before only with a lower worst ratio and
+    no more triangles above the margin (a lower worst bought with more bad
+    triangles traded conebox's chart margin for a violation on the surface)."""
+    import sr33.samplers.layers as ly
+    from sr33.samplers.repair import ATTEMPTS, Repaired
+
+    uv = np.zeros((4, 2))
+    free = np.ones(4, dtype=bool)
+
+    def answer(worst, bad):
+        return Repaired(uv=uv.copy(), origin=np.arange(4), bad=bad, worst=worst)
+
+    calls = []
+    monkeypatch.setattr(ly, "split_corners", lambda uv, free, h, r, **kw: r)
+    for shaken, kept in [
+        (answer(0.8500, 5), 0.8592),  # lower worst, more bad: not taken
+        (answer(0.8298, 0), 0.8298),  # better on both counts: taken
+        (answer(0.8700, 1), 0.8592),  # fewer bad, higher worst: not taken
+    ]:
+
+        def fake(uv, free, h, shaken=shaken, **kw):
+            calls.append(kw)
+            return shaken
+
+        monkeypatch.setattr(ly, "repair", fake)
+        r = ly.unstuck(uv, free, 0.1, answer(0.8592, 2), 0.85, wide=False)
+        assert r.worst == kept
+    assert all(kw["shakes_from"] == ATTEMPTS and kw["retry_bad"] == 1 for kw in calls)
+    # a face below the stuck bound is left alone
+    calls.clear()
+    assert ly.unstuck(uv, free, 0.1, answer(0.84, 3), 0.85, wide=False).worst == 0.84
+    assert calls == []
