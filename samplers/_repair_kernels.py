@@ -259,8 +259,9 @@ def delaunay_flips(pts, tri, nbr, tol_area, tol_circle):
     neighbours ``nbr`` opposite each corner, -1 on the hull), by Lawson's
     edge flips; or None where flips cannot make it (the positions must be
     tiled by the triangles as they are: every triangle counter-clockwise
-    with twice its area above ``tol_area``, every vertex's angles adding up
-    to 2π inside and at most π on the hull).
+    with twice its area above ``tol_area``, and the hull's edges a convex
+    polygon, turning left or straight at every vertex and once round in
+    all; the triangles then cover it once, their map having degree one).
 
     An edge is flipped when its neighbour's far corner lies inside a
     triangle's circumcircle by more than ``tol_circle`` (the in-circle
@@ -272,31 +273,47 @@ def delaunay_flips(pts, tri, nbr, tol_area, tol_circle):
     """
     n = pts.shape[0]
     m = tri.shape[0]
-    angle = np.zeros(n)
-    hull = np.zeros(n, dtype=np.bool_)
+    # every triangle counter-clockwise ...
+    for t in range(m):
+        a = tri[t, 0]
+        b = tri[t, 1]
+        c = tri[t, 2]
+        ux = pts[b, 0] - pts[a, 0]
+        uy = pts[b, 1] - pts[a, 1]
+        vx = pts[c, 0] - pts[a, 0]
+        vy = pts[c, 1] - pts[a, 1]
+        if ux * vy - uy * vx <= tol_area:
+            return None
+    # ... and the hull's cycle turning left (or straight) at every vertex,
+    # once round in all: a convex polygon, which the triangles (all of
+    # degree one) then cover once
+    after = np.full(n, -1, dtype=np.int64)
+    start = -1
+    count = 0
     for t in range(m):
         for k in range(3):
-            a = tri[t, k]
-            b = tri[t, (k + 1) % 3]
-            c = tri[t, (k + 2) % 3]
-            ux = pts[b, 0] - pts[a, 0]
-            uy = pts[b, 1] - pts[a, 1]
-            vx = pts[c, 0] - pts[a, 0]
-            vy = pts[c, 1] - pts[a, 1]
-            cross = ux * vy - uy * vx
-            if cross <= tol_area:
-                return None
-            angle[a] += np.arctan2(cross, ux * vx + uy * vy)
             if nbr[t, k] < 0:
-                hull[b] = True
-                hull[c] = True
-    for v in range(n):
-        if hull[v]:
-            # (a hull vertex between collinear ones has π, within rounding)
-            if angle[v] > np.pi + 1e-10:
-                return None
-        elif abs(angle[v] - 2.0 * np.pi) > 1e-6:
+                after[tri[t, (k + 1) % 3]] = tri[t, (k + 2) % 3]
+                start = tri[t, (k + 1) % 3]
+                count += 1
+    turning = 0.0
+    v = start
+    for _ in range(count):
+        w = after[v]
+        x = after[w]
+        if w < 0 or x < 0:
             return None
+        ux = pts[w, 0] - pts[v, 0]
+        uy = pts[w, 1] - pts[v, 1]
+        vx = pts[x, 0] - pts[w, 0]
+        vy = pts[x, 1] - pts[w, 1]
+        turn = np.arctan2(ux * vy - uy * vx, ux * vx + uy * vy)
+        if turn < -1e-10:
+            return None
+        turning += turn
+        v = w
+    if v != start or abs(turning - 2.0 * np.pi) > 1e-6:
+        return None
     tri = tri.copy()
     nbr = nbr.copy()
     stack_t = np.empty(3 * m + 64, dtype=np.int64)
