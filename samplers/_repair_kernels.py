@@ -431,3 +431,36 @@ def same_points(of_before, of, before, pts, reach):
         if abs(before[i, 0] - pts[i, 0]) > reach or abs(before[i, 1] - pts[i, 1]) > reach:
             return False
     return True
+
+
+@njit(cache=True)
+def centroids(pts, tri):
+    """(m, 2): the triangles' centroids, ``pts[tri].mean(axis=1)`` bit for bit
+    (numpy adds the corners in order, then divides by 3)."""
+    m = tri.shape[0]
+    out = np.empty((m, 2))
+    for t in range(m):
+        a = tri[t, 0]
+        b = tri[t, 1]
+        c = tri[t, 2]
+        out[t, 0] = ((pts[a, 0] + pts[b, 0]) + pts[c, 0]) / 3.0
+        out[t, 1] = ((pts[a, 1] + pts[b, 1]) + pts[c, 1]) / 3.0
+    return out
+
+
+@njit(cache=True)
+def grid_lookup(pts, lo, cell, grid):
+    """The cell of ``grid`` (rows along y) each point falls in, as
+    :class:`sr33.samplers.chart.Raster` looks it up; False outside."""
+    ny, nx = grid.shape
+    out = np.zeros(pts.shape[0], dtype=np.bool_)
+    for k in range(pts.shape[0]):
+        x = (pts[k, 0] - lo[0]) / cell
+        y = (pts[k, 1] - lo[1]) / cell
+        if not (np.isfinite(x) and np.isfinite(y)):
+            continue
+        i = np.floor(x)
+        j = np.floor(y)
+        if i >= 0 and i < nx and j >= 0 and j < ny:
+            out[k] = grid[int(j), int(i)]
+    return out

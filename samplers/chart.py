@@ -16,6 +16,8 @@ from scipy.spatial import cKDTree
 
 from sr33.mesh import dot
 
+from ._repair_kernels import grid_lookup
+
 ARC_MARGIN = 0.5  # free samples keep this far (times h) from a cylinder's rim (else h / 4)
 
 
@@ -43,12 +45,8 @@ class Raster:
         self.grid = grid
 
     def __call__(self, pts: np.ndarray) -> np.ndarray:
-        ij = np.floor((pts - self.lo) / self.cell).astype(np.int64)
-        ny, nx = self.grid.shape
-        ok = (ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny)
-        out = np.zeros(pts.shape[0], dtype=bool)
-        out[ok] = self.grid[ij[ok, 1], ij[ok, 0]]
-        return out
+        pts = np.ascontiguousarray(np.asarray(pts, dtype=np.float64).reshape(-1, 2))
+        return grid_lookup(pts, self.lo, float(self.cell), self.grid)
 
 
 @dataclass(frozen=True)

@@ -52,7 +52,13 @@ from scipy.spatial import Delaunay, QhullError, cKDTree
 from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
 
-from ._repair_kernels import canonical_order, delaunay_flips, energy_terms, same_points
+from ._repair_kernels import (
+    canonical_order,
+    centroids,
+    delaunay_flips,
+    energy_terms,
+    same_points,
+)
 
 TARGET = 0.78  # the descent pushes every ratio below this
 BAD = 0.83  # a triangle above this still needs work (margin below sqrt(3)/2)
@@ -295,7 +301,7 @@ def _triangles(prob: _Problem, subset=None):
     tri = _delaunay(prob, pts, of)
     # a triangle across a straight edge (on the frame) is judged with the face's
     # own: its geodesic is the straight line of the unfolding
-    keep = prob.inside(pts[tri].mean(axis=1)) | (of[tri] == FRAME).any(axis=1)
+    keep = prob.inside(centroids(pts, tri)) | (of[tri] == FRAME).any(axis=1)
     return pts, of, turned, tri[keep]
 
 

@@ -199,3 +199,26 @@ def test_the_straight_edges_kernels_are_the_numpy_code_bit_for_bit(seed, n, m):
     assert lk.project(p, a, d, dd, lo).tobytes() == naive_line_project(p, a, d, lo).tobytes()
     t = ((p[:, None, :] - a[None]) * d[None]).sum(axis=-1) / dd[None]
     assert lk.along(p, a, d, dd).tobytes() == t.tobytes()
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 300), m=st.integers(0, 500))
+def test_centroids_and_the_rasters_lookup_are_numpys_bit_for_bit(seed, n, m):
+    """The repair asks at every step which triangles' centroids lie in the
+    face: the kernels give numpy's centroids and the raster's cells exactly
+    (points outside the grid, NaN and infinities among them, are outside)."""
+    from sr33.samplers._repair_kernels import centroids, grid_lookup
+
+    rng = np.random.default_rng(seed)
+    pts = rng.uniform(-3.0, 3.0, (n, 2))
+    tri = rng.integers(0, n, (m, 3))
+    assert centroids(pts, tri).tobytes() == pts[tri].mean(axis=1).tobytes()
+    grid = rng.random((37, 23)) < 0.5
+    lo, cell = np.array([-2.0, -2.5]), 0.13
+    q = np.vstack([pts, [[np.nan, 0.0], [np.inf, 1.0], [0.0, -np.inf], [1e300, 0.0]]])
+    ij = np.floor((q - lo) / cell)
+    ok = np.isfinite(ij).all(axis=1) & (ij[:, 0] >= 0) & (ij[:, 0] < 23) & (ij[:, 1] >= 0)
+    ok &= ij[:, 1] < 37
+    want = np.zeros(len(q), dtype=bool)
+    want[ok] = grid[ij[ok, 1].astype(int), ij[ok, 0].astype(int)]
+    np.testing.assert_array_equal(grid_lookup(q, lo, cell, grid), want)
