@@ -737,6 +737,7 @@ def repair_planar_faces(
                 repair(uv, free, h, **args),
                 STUCK,
                 wide=bool(arcs) and all(a.closed for a in arcs),
+                shake=not further,
                 **args,
             )
         r = done[key]
@@ -786,12 +787,23 @@ def repair_planar_faces(
     return reports
 
 
-def unstuck(uv, free, h: float, first: Repaired, stuck: float, wide: bool = True, **kwargs):
+def unstuck(
+    uv,
+    free,
+    h: float,
+    first: Repaired,
+    stuck: float,
+    wide: bool = True,
+    shake: bool = True,
+    **kwargs,
+):
     """A repair's answer ``first`` retried where it is stuck at or above
     ``stuck``: again with cells of circumradius up to ``RETRY_WIDE`` h (when
     ``wide``), then, with at most ``FEW_BAD`` bad triangles, with its corners
-    split (:func:`sr33.samplers.repair.split_corners`); and, still stuck,
-    from shaken starts (the repair's further attempts, however few its bad
+    split (:func:`sr33.samplers.repair.split_corners`); and, still stuck
+    with at most ``FEW_BAD`` bad triangles (and ``shake``: a planar face's
+    first round only; its further rounds start from this answer), from
+    shaken starts (the repair's further attempts, however few its bad
     triangles, with new seeds), their best answer's corners split too,
     which replaces the answer before only when it is better on both counts:
     a lower worst ratio and no more triangles above the margin.  A lower
@@ -811,7 +823,7 @@ def unstuck(uv, free, h: float, first: Repaired, stuck: float, wide: bool = True
             r = again
     if r.worst >= stuck and r.bad <= FEW_BAD:
         r = split_corners(uv, free, h, r, **kwargs)  # r itself unless it beats it
-    if r.worst >= stuck:
+    if shake and r.worst >= stuck and r.bad <= FEW_BAD:
         more = {"retry_bad": 1, "retry_worst": stuck, "shakes_from": ATTEMPTS}
         shaken = repair(uv, free, h, **{**kwargs, **more})
         if shaken.worst >= stuck and shaken.bad <= FEW_BAD:
