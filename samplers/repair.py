@@ -85,10 +85,11 @@ RETRY_BAD = 20
 ATTEMPTS = 6  # ... up to this many in all, from the input shaken
 STALL = 16  # ... each ending after this many edits without fewer bad triangles
 GHOST, FRAME = -1, -2  # the sample id of a ghost point and of a frame point
-# a step's triangles are kept from the step before while they are still
-# Delaunay (:func:`_delaunay`): points moved at most this far (times h), twice
-# every triangle's area above this (times h²), in-circle determinants of
-# neighbours at most this (times h⁴: cocircular within rounding)
+# a step's triangles are mended from the step before by edge flips
+# (:func:`_delaunay`) when its points moved at most this far (times h) and
+# every triangle's doubled area stays above this (times h²); an edge is
+# flipped when its in-circle determinant exceeds this (times h⁴: cocircular
+# within rounding keeps its diagonal)
 KEEP_MOVE, KEEP_AREA, KEEP_CIRCLE = 0.25, 1e-9, 1e-10
 
 
