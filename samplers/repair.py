@@ -330,7 +330,7 @@ def _delaunay(prob: _Problem, pts: np.ndarray, of: np.ndarray) -> np.ndarray:
             tri, nbr, flips = flipped
             if flips:
                 tri, nbr = canonical_order(tri, nbr)
-            prob.delaunay = (last[0], pts.copy(), tri, nbr)
+            prob.delaunay = (last[0], pts, tri, nbr)
             return tri
     try:
         d = Delaunay(pts)
@@ -343,7 +343,8 @@ def _delaunay(prob: _Problem, pts: np.ndarray, of: np.ndarray) -> np.ndarray:
     used = np.zeros(pts.shape[0], dtype=bool)
     used[tri.ravel()] = True
     kept = used.all() and smallest > KEEP_AREA * h * h
-    prob.delaunay = (of.copy(), pts.copy(), tri, nbr) if kept else None
+    # (``pts`` and ``of`` are new arrays of every step's extended(): kept as they are)
+    prob.delaunay = (of, pts, tri, nbr) if kept else None
     return tri
 
 
