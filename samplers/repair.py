@@ -192,13 +192,18 @@ class _Problem:
         self.frame_id = FRAME if judge_frame else GHOST
         self.turn = turn
         self.wide = wide
+        # fixed samples that were within 1.5 h of a movable sample an edit
+        # removed: watched for good (else a search that removes every free
+        # sample of a region judges no triangle there, worst 0)
+        self.orphans = np.zeros(self.uv.shape[0], dtype=bool)
         self._watch: np.ndarray | None = None
         # the last triangulation: (ids, positions, triangles, neighbours), see _delaunay
         self.delaunay: tuple | None = None
 
     def watch(self) -> np.ndarray:
         """Samples whose triangles are judged: the movable ones and fixed ones
-        within 1.5 h of them (a removal may open a bad triangle among those).
+        within 1.5 h of them (a removal may open a bad triangle among those),
+        or within 1.5 h of a movable sample an edit removed (``orphans``).
 
         Kept until :meth:`forget`: a descent forgets it when it starts and
         when it ends (within one descent the samples move a few hundredths
@@ -213,12 +218,17 @@ class _Problem:
 
     def _compute_watch(self) -> np.ndarray:
         move = self.free | self.slide
-        out = move.copy()
+        out = move | self.orphans
         if move.any() and (~move).any():
-            pos, _, _ = self.images(np.flatnonzero(move))
-            d, _ = cKDTree(np.vstack([self.uv[move], pos])).query(self.uv[~move])
-            out[~move] = d < 1.5 * self.h
+            out[~move] |= self.near(np.flatnonzero(move), ~move)
         return out
+
+    def near(self, idx: np.ndarray, of: np.ndarray) -> np.ndarray:
+        """Which samples ``of`` (a mask) lie within 1.5 h of a sample ``idx``
+        or of its images across a development's glued sides."""
+        pos, _, _ = self.images(idx)
+        d, _ = cKDTree(np.vstack([self.uv[idx], pos])).query(self.uv[of])
+        return d < 1.5 * self.h
 
     def images(self, idx: np.ndarray):
         """Copies of the samples ``idx`` across the glued sides of a cone's
@@ -261,12 +271,13 @@ class _Problem:
     def copy(self) -> _Problem:
         c = _Problem.__new__(_Problem)
         c.__dict__.update(self.__dict__)
-        c.uv, c.free, c.slide, c.anchor, c.origin = (
+        c.uv, c.free, c.slide, c.anchor, c.origin, c.orphans = (
             self.uv.copy(),
             self.free.copy(),
             self.slide.copy(),
             self.anchor.copy(),
             self.origin.copy(),
+            self.orphans.copy(),
         )
         c._watch = None
         return c
@@ -731,13 +742,19 @@ def _edited(prob: _Problem, edits) -> _Problem:
     trial = prob.copy()
     trial.delaunay = None  # the samples' ids shift
     keep = np.ones(trial.uv.shape[0], dtype=bool)
-    keep[[arg for kind, arg in edits if kind == "del"]] = False
+    gone = np.array([arg for kind, arg in edits if kind == "del"], dtype=np.int64)
+    keep[gone] = False
+    fixed = ~(trial.free | trial.slide) & keep
+    gone = gone[(trial.free | trial.slide)[gone]]
+    if gone.size and fixed.any():
+        trial.orphans[fixed] |= trial.near(gone, fixed)
     add = [np.asarray(arg, dtype=np.float64) for kind, arg in edits if kind == "add"]
     trial.uv = np.vstack([trial.uv[keep], *[trial.wrap(a[None]) for a in add]])
     trial.free = np.r_[trial.free[keep], np.ones(len(add), dtype=bool)]
     trial.slide = np.r_[trial.slide[keep], np.zeros(len(add), dtype=bool)]
     trial.anchor = np.r_[trial.anchor[keep], np.zeros(len(add), dtype=bool)]
     trial.origin = np.r_[trial.origin[keep], np.full(len(add), -1)]
+    trial.orphans = np.r_[trial.orphans[keep], np.zeros(len(add), dtype=bool)]
     return trial
 
 
