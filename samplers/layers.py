@@ -1277,6 +1277,7 @@ def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float,
         rho_a, ang_a, row_a, rim_ang, slant, sin_a, t, keep, broken_at, inner=inner
     )
     # stuck: once more, wider, the apex's neighbourhood settled
+    args = (rim_ang, slant, sin_a, t, inner)
     if got[4] >= broken_at:
         wide = _repair_developed(
             *got[:3],
@@ -1289,11 +1290,21 @@ def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float,
             movable=WIDE_MOVABLE,
             inner=inner,
         )
-        got = wide if wide[4] < got[4] else got
+        # by the whole development and the apex (the wider repair keeps the
+        # apex's neighbourhood and does not judge the triangles there)
+        if _rings_judged(wide, *args) < _rings_judged(got, *args):
+            got = wide
+    return _ConeRings(got[0], got[1], got[2], nrows, got[3], got[4], _rings_judged(got, *args))
+
+
+def _rings_judged(got, rim_ang, slant: float, sin_a: float, t: float, inner) -> float:
+    """The worst ratio of a cone's repaired rings ``got`` (rho, ang, ...): on
+    the whole development (:func:`_developed_worst`) and, with an apex,
+    round it (:func:`_apex_worst`)."""
     judged = _developed_worst(got[0], got[1], rim_ang, slant, sin_a, t)
     if inner is None:
         judged = max(judged, _apex_worst(got[0], got[1], rim_ang, slant, sin_a, t))
-    return _ConeRings(got[0], got[1], got[2], nrows, got[3], got[4], judged)
+    return judged
 
 
 def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
@@ -1645,6 +1656,7 @@ def _repair_developed(
         inside=inside,
         clamp=radial_clamp(hole + 0.25 * t if inner is not None else 0.0, slant - 0.25 * t),
         turn=turn,
+        retry_bad=1,
     )
     mine = out.origin < n  # not the rim nor the apex
     uv2 = out.uv[mine]
