@@ -68,8 +68,9 @@ def test_find_pyramid_knows_a_right_square_pyramid_only():
     assert pyramid_steps(1.0, 1.0, 0.1) == 10 and pyramid_steps(1.0, 1.0, 1.0) == 4
 
 
-# slow since stop 56: the flips' last bits leave its four faces stuck through
-# the sixteen further rounds (57 s on 9acc45c, 315 s now); see docs/sampler.md
+# slow since stop 56: its four lateral faces stay stuck (0.89 to 0.96, 11 to 48
+# triangles above the margin): 57 s on 9acc45c, 315 s at stop 56 (sixteen
+# further rounds), 105 s since its faces leave the rounds at a repeat (stop 57)
 @pytest.mark.slow
 def test_a_flat_pyramid_keeps_its_scan_rows():
     """At height 0.3 on a base of 2 the base edges are 16.7° sharp: one
