@@ -1548,8 +1548,11 @@ def _notched_cylinder():
 
 @pytest.mark.xfail(
     strict=True,
-    reason="stop 56 regression: on the repair's edge-flip path the notched cylinder's "
-    "charts end at 0.884 (0.842 on 9acc45c); not yet traced",
+    reason="stop 56 regression: on the repair's edge-flip path the notched cylinder ends at "
+    "0.884 (0.842 on 9acc45c).  Traced (stop 57): one triangle across the bottom rim, two "
+    "disk samples 2.1 h apart and a rim sample; the disk's repair judged it against the "
+    "ghost rows that stand for the wall, and the wall's chart repair has it as frame and rim "
+    "only (no movable corner: not judged), so neither face's repair sees it",
 )
 def test_a_cylinder_notched_by_a_ball_is_repaired_in_its_charts():
     """Faces no layout takes are repaired in charts of their own, whatever
