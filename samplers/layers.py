@@ -579,8 +579,8 @@ def repair_planar_faces(
     face's round did not end as the one before, with the same worst ratio
     (to 1e-6) and bad triangles (``last``, per face: a fixed point up to
     the last bits; star prism turned a, a face at 0.9167 with 5 in all
-    sixteen rounds, 16 s; a pyramid 0.3 high on a base of 2, two faces
-    from the fourth round on, 315 s in all; a face whose rounds wander,
+    sixteen rounds; a pyramid 0.3 high on a base of 2, two faces from the
+    fourth round on, 315 s in all, now 105 s; a face whose rounds wander,
     conebox turned b's top from 0.863 through 0.858 and 0.865 to 0.842 in
     the fifteenth, goes on), at most
     ``again`` rounds (fillet_box's bottom: two
@@ -1261,7 +1261,10 @@ def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float,
     (:func:`_end_columns` with ``limits`` = (end gap, merged gap), times
     t); the ring round the apex becomes a designed fan where one exists;
     then the development's repair (:func:`_repair_developed`), once more
-    wider where it is left stuck.
+    wider where it is left stuck, that answer kept when it is better by the
+    whole development and the apex (:func:`_rings_judged`; the wider
+    repair keeps the apex's neighbourhood, and its own worst ratio does not
+    see the triangles there).
     """
     end_gap, merged = limits
     ang = rim_ang
@@ -1634,6 +1637,10 @@ def _repair_developed(
     distance from the apex, its samples' angles): the development is then an
     annular sector, the small rim's samples are fixed like the rim's (in
     place of the apex) and the samples stay at least t / 4 off both rims.
+    The development is isometric, so one triangle left breaking III-ii is
+    real and the repair's further attempts run for it (``retry_bad`` 1: a
+    cone 0.37 by 0.8 ended one plan at 0.890 round its apex without them,
+    0.829 with them).
     Returns the new (rho, ang, row; -1 for an added sample), the
     triangles left above the repair's margin and the worst ratio.
     """
