@@ -574,13 +574,14 @@ def repair_planar_faces(
     prism's two ends; their sides' columns run straight from one to the
     other).  A face still left with at most ``FEW_BAD`` triangles at or
     above ``STUCK`` is repaired again from that answer, round after round
-    while it stays stuck and the round before moved a sample (else the next
-    would repeat it: conebox turned b ran 13 identical rounds) and the
-    face's round did not end as the one before, with the same worst ratio
-    (to 1e-6) and bad triangles (``last``, per face: a fixed point up to
-    the last bits; star prism turned a, a face at 0.9167 with 5 in all
-    sixteen rounds; a pyramid 0.3 high on a base of 2, two faces from the
-    fourth round on, 315 s in all, now 105 s; a face whose rounds wander,
+    while it stays stuck and its round did not end as the one before, with
+    the same worst ratio (to 1e-6) and bad triangles (``last``, per face,
+    given to the further rounds: a fixed point up to the last bits, or
+    exactly, where a round moved no sample and the next would repeat it:
+    conebox turned b ran 13 identical rounds; star prism turned a, a face
+    at 0.9167 with 5 in all sixteen rounds; a pyramid 0.3 high on a base
+    of 2, two faces from the fourth round on, 315 s in all, now 105 s; a
+    face whose rounds wander,
     conebox turned b's top from 0.863 through 0.858 and 0.865 to 0.842 in
     the fifteenth, goes on), at most
     ``again`` rounds (fillet_box's bottom: two
@@ -590,10 +591,7 @@ def repair_planar_faces(
     """
     reports = []
     done: dict[tuple, object] = {}
-    # a further round that leaves every sample where it was would be repeated
-    # as it is by the next (the same input): the rounds end there
-    further = walls is not None
-    entry = s.points.copy() if further else None
+    further = last is not None
     # a full cylinder's first rim laid: its samples (3-D); a face repaired
     # again gets the rims laid in the first round
     walls = {} if walls is None else walls
@@ -785,8 +783,7 @@ def repair_planar_faces(
         again,
         ", ".join(f"{x['face']} {x['worst']:.4f} ({x['bad']} bad)" for x in reports),
     )
-    unchanged = further and entry.shape == s.points.shape and np.array_equal(entry, s.points)
-    if again > 0 and stuck and not unchanged:
+    if again > 0 and stuck:
         rest = set(range(len(faces))) - stuck
         redone = {
             x["face"]: x
@@ -1302,6 +1299,7 @@ def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float,
     )
     # stuck: once more, wider, the apex's neighbourhood settled
     args = (rim_ang, slant, sin_a, t, inner)
+    judged = _rings_judged(got, *args)
     if got[4] >= broken_at:
         wide = _repair_developed(
             *got[:3],
@@ -1316,9 +1314,10 @@ def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float,
         )
         # by the whole development and the apex (the wider repair keeps the
         # apex's neighbourhood and does not judge the triangles there)
-        if _rings_judged(wide, *args) < _rings_judged(got, *args):
-            got = wide
-    return _ConeRings(got[0], got[1], got[2], nrows, got[3], got[4], _rings_judged(got, *args))
+        wide_judged = _rings_judged(wide, *args)
+        if wide_judged < judged:
+            got, judged = wide, wide_judged
+    return _ConeRings(got[0], got[1], got[2], nrows, got[3], got[4], judged)
 
 
 def _rings_judged(got, rim_ang, slant: float, sin_a: float, t: float, inner) -> float:

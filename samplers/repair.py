@@ -763,8 +763,9 @@ def _edited(prob: _Problem, edits) -> _Problem:
     keep = np.ones(trial.uv.shape[0], dtype=bool)
     gone = np.array([arg for kind, arg in edits if kind == "del"], dtype=np.int64)
     keep[gone] = False
-    fixed = ~(trial.free | trial.slide) & keep
-    gone = gone[(trial.free | trial.slide)[gone]]
+    move = trial.free | trial.slide
+    fixed = ~move & keep
+    gone = gone[move[gone]]
     if gone.size and fixed.any():
         trial.orphans[fixed] |= trial.near(gone, fixed)
     add = [np.asarray(arg, dtype=np.float64) for kind, arg in edits if kind == "add"]
