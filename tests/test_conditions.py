@@ -288,6 +288,55 @@ def test_edges_plainly_not_delaunay_are_flipped(height, crossings, exact, flippe
     assert sorted(t.tolist()) == want
 
 
+@pytest.mark.parametrize(
+    "dy, delaunay",
+    [
+        (0.0, "cd"),  # d 0.006 inside the circle of (a, b, c): (c, d) is Delaunay
+        (0.06, "ab"),  # d 0.05 outside it: (a, b) is
+    ],
+)
+@pytest.mark.parametrize("extra", [(2, 3, 1), (0, 2, 3)])
+def test_crossed_diagonals_of_a_near_tie_keep_the_delaunay_pair(dy, delaunay, extra):
+    """Labels at a near tie of four samples that took both diagonals: the
+    edge (a, b) with its triangles (a, b, c) and (a, b, d), and (c, d) with
+    a third triangle (either one), three overlapping triangles (a conebox's
+    top read 0.982 on the diagonal that is not Delaunay, 0.796 on the
+    other).  The angle test keeps one diagonal and its two triangles; a
+    quad whose (c, d) has a triangle with a fifth sample is left alone."""
+    from sr33.mesh import triangle_ratios
+    from sr33.validators.conditions import _flip_to_delaunay, _quads, _uncrossed
+
+    # the conebox's four samples (times h), d on or off the circle of (a, b, c)
+    pts = np.array([[-1.524, -0.258], [0.719, 0.51], [0.805, -0.252], [-0.36, 1.185 + dy]])
+    tri = np.sort(np.array([[0, 1, 2], [0, 1, 3], extra]), axis=1)
+    edges = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
+    cross = np.full(6, 3)
+
+    class Geodesics:
+        def __call__(self, pairs):
+            return np.linalg.norm(pts[pairs[:, 0]] - pts[pairs[:, 1]], axis=1)
+
+        def exact(self, pairs):
+            return np.ones(pairs.shape[0], dtype=bool)
+
+    e, c, t = _flip_to_delaunay(pts, (edges, cross, tri), Geodesics())
+    got = {tuple(x) for x in e.tolist()}
+    assert len(c) == len(e) == 5
+    if delaunay == "cd":
+        assert (0, 1) not in got and (2, 3) in got
+        assert sorted(t.tolist()) == [[0, 2, 3], [1, 2, 3]]
+        assert triangle_ratios(pts, t).max() < 0.8
+    else:
+        assert (0, 1) in got and (2, 3) not in got
+        assert sorted(t.tolist()) == [[0, 1, 2], [0, 1, 3]]
+    # (c, d) also on a triangle with a fifth sample: not a crossed quad of four
+    pts = np.vstack([pts, [[0.2, 6.0]]])
+    tri5 = np.vstack([tri, [2, 3, 4]])
+    edges5 = np.vstack([edges, [[2, 4], [3, 4]]])
+    q = _quads(tri5, edges5, 5)
+    assert _uncrossed(q, edges5, np.full(8, 3), tri5, Geodesics(), 5) is None
+
+
 def test_conditions_command_exits_1_when_a_condition_fails(plane, tmp_path, capsys):
     # an equilateral lattice stretched 2x along x: its Delaunay triangles
     # have a short edge far below sqrt(3)/2 of the longest -> III-ii fails

@@ -177,6 +177,30 @@ def test_flips_give_up_on_a_turned_over_triangle_and_keep_a_squares_diagonal():
     assert delaunay_flips(crossed, tri, nbr, 1e-9, 1e-10) is None
 
 
+def test_a_flat_triangle_on_the_hull_is_dropped_and_the_rest_carried():
+    """Qhull's ``Qt`` can leave three collinear points on the hull as a
+    triangle of no area: it is dropped (its neighbours see the hull there),
+    and the rest passes the flips' check, so that it is carried to the next
+    step instead of triangulated anew; a flat triangle inside stays."""
+    from sr33.samplers._repair_kernels import delaunay_flips
+    from sr33.samplers.repair import _without_flat_hull
+
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [1.0, 1.0]])
+    tri = np.array([[0, 1, 3], [1, 2, 3], [0, 1, 2]])
+    # neighbour k is across from corner k
+    nbr = np.array([[1, -1, 2], [-1, 0, 2], [1, -1, 0]])
+    kept, knbr = _without_flat_hull(pts, tri, nbr, 1e-9)
+    np.testing.assert_array_equal(kept, tri[:2])
+    np.testing.assert_array_equal(knbr, [[1, -1, -1], [-1, 0, -1]])
+    out = delaunay_flips(pts, kept, knbr, 1e-9, 1e-10)
+    assert out is not None and out[2] == 0
+    with_flat = delaunay_flips(pts, tri, nbr, 1e-9, 1e-10)
+    assert with_flat is None  # what made every step call Qhull
+    # a flat triangle inside (not on the hull) is not dropped
+    inner = np.array([[1, -1, 2], [-1, 0, 2], [1, 5, 0]])
+    np.testing.assert_array_equal(_without_flat_hull(pts, tri, inner, 1e-9)[0], tri)
+
+
 def test_a_developments_apex_has_no_image():
     """A development's apex, at the origin, has no image across the glued
     sides: it would be a second point there, which Qhull drops, and the

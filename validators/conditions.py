@@ -694,9 +694,74 @@ def _cell_curvature(tv, tf, label, snap, n: int) -> np.ndarray:
     return np.bincount(label[ok], weights=defect[ok], minlength=n)
 
 
+def _uncrossed(q, edges, cross, tri, geodesics: _Geodesics, n: int):
+    """DT_M with its crossed quads undone, or None without any.
+
+    At a near tie of four samples a, b, c, d the labels can take both
+    diagonals: the edge (a, b) with its triangles (a, b, c) and (a, b, d),
+    and the edge (c, d) with (c, d, a) or (c, d, b) as well, three
+    overlapping triangles where DT_M has two (a conebox's top, four samples
+    0.006 h off one circle of radius 1.19 h: its triangle of the diagonal
+    that is not Delaunay read 0.982, the Delaunay pair 0.796).  The
+    diagonal of the intrinsic Delaunay angle test is kept (the angles at c
+    and d of the geodesic lengths summing to more than π: (c, d); else
+    (a, b)) with its two triangles; the other diagonal and every other
+    triangle of the four samples go.  (a, b) is taken for a diagonal only
+    where c and d lie on either side of it (the angle c-a-d, developed from
+    the geodesic lengths, is nearer the sum of c-a-b and b-a-d than their
+    difference): of the four's three triangles, two share a side of the
+    quad and overlap.  A quad whose (c, d) has a triangle with a fifth
+    sample is left alone, as are quads sharing a sample with one undone
+    before them in this pass (the next round takes them).
+    """
+    code = edges[:, 0] * n + edges[:, 1]
+    cd = np.minimum(q[:, 2], q[:, 3]) * n + np.maximum(q[:, 2], q[:, 3])
+    crossed = q[np.isin(cd, code)]
+    if crossed.shape[0] == 0:
+        return None
+    pairs = np.sort(
+        np.concatenate(
+            [crossed[:, [i, j]] for i, j in ((0, 1), (0, 2), (1, 2), (0, 3), (1, 3), (2, 3))]
+        ),
+        axis=1,
+    )
+    ab, ac, bc, ad, bd, cd_len = geodesics(pairs).reshape(6, -1)
+    # (a, b) is a diagonal of the four when c and d lie on either side of it:
+    # the angle c-a-d is the sum of c-a-b and b-a-d, not their difference
+    at_c, at_d = _angle(ab, ac, bc), _angle(ab, ad, bd)
+    cad = _angle(ac, ad, cd_len)
+    apart = np.minimum(np.abs(cad - (at_c + at_d)), np.abs(2.0 * np.pi - at_c - at_d - cad))
+    diagonal = apart < np.abs(cad - np.abs(at_c - at_d))
+    crossed = crossed[diagonal]
+    to_cd = (_angle(ac, bc, ab) + _angle(ad, bd, ab) > np.pi)[diagonal]
+    drop = np.zeros(tri.shape[0], dtype=bool)
+    gone_edges: list[int] = []
+    new_tri: list[tuple[int, int, int]] = []
+    touched: set[int] = set()
+    for (a, b, c, d), flip in zip(crossed.tolist(), to_cd.tolist()):
+        quad = np.array([a, b, c, d])
+        if touched.intersection(quad.tolist()):
+            continue
+        within = np.isin(tri, quad).all(axis=1)
+        on_cd = (tri == c).any(axis=1) & (tri == d).any(axis=1)
+        if (on_cd & ~within).any():
+            continue
+        touched.update(quad.tolist())
+        drop |= within
+        keep, lose = ((c, d), (a, b)) if flip else ((a, b), (c, d))
+        gone_edges.append(min(lose) * n + max(lose))
+        new_tri += [tuple(sorted((*keep, x))) for x in lose]
+    if not touched:
+        return None
+    tri = unique_rows(np.concatenate([tri[~drop], np.array(new_tri, dtype=tri.dtype)]))
+    kept = ~np.isin(code, gone_edges)
+    return edges[kept], cross[kept], tri
+
+
 def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8, curvature=None):
     """Decide the near ties of DT_M, and mend the labels' plain errors, by
-    the intrinsic Delaunay criterion.
+    the intrinsic Delaunay criterion.  Each round first undoes the quads
+    whose two diagonals the labels both took (:func:`_uncrossed`).
 
     For each edge (a, b) with triangles (a, b, c) and (a, b, d), the angles
     at c and d come from the geodesic lengths of the five pairs (each
@@ -728,6 +793,10 @@ def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8, curvature
         q = _quads(tri, edges, n) if tri.size else np.empty((0, 4), dtype=np.int64)
         if q.size == 0:
             break
+        uncrossed = _uncrossed(q, edges, cross, tri, geodesics, n)
+        if uncrossed is not None:
+            edges, cross, tri = uncrossed
+            q = _quads(tri, edges, n)
         pairs = np.sort(
             np.concatenate([q[:, [0, 1]], q[:, [0, 2]], q[:, [1, 2]], q[:, [0, 3]], q[:, [1, 3]]]),
             axis=1,
