@@ -11,6 +11,8 @@ energy must not move one.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from sr33.jit import njit
@@ -464,3 +466,51 @@ def grid_lookup(pts, lo, cell, grid):
         if i >= 0 and i < nx and j >= 0 and j < ny:
             out[k] = grid[int(j), int(i)]
     return out
+
+
+@njit(cache=True)
+def gathered_gradient(of, gp, n, move):
+    """(n, 2): the gradient ``gp`` of the extended points added up per sample
+    ``of`` (ghosts and frame points, ``of`` < 0, left out), one after
+    another in their order from zero as ``np.bincount`` adds them, and
+    zero on the samples that do not ``move``."""
+    grad = np.zeros((n, 2))
+    for k in range(of.shape[0]):
+        v = of[k]
+        if v >= 0:
+            grad[v, 0] += gp[k, 0]
+            grad[v, 1] += gp[k, 1]
+    for v in range(n):
+        if not move[v]:
+            grad[v, 0] = 0.0
+            grad[v, 1] = 0.0
+    return grad
+
+
+@njit(cache=True)
+def descent_step(uv, grad, movable, label, regions, step):
+    """One step of the repair's descent, in place: every ``movable`` sample
+    moves against its gradient by ``step`` times its gradient over the
+    largest gradient norm of its region (``label``, one of ``regions``),
+    so that the largest move per region is ``step``.  Returns which samples
+    moved (none where every region's largest norm is zero).  Bit for bit
+    the numpy code it replaced: ``np.linalg.norm`` rows, ``np.maximum.at``
+    per region from zero, ``uv[move] -= (step / g)[:, None] * grad``."""
+    n = uv.shape[0]
+    peak = np.zeros(regions)
+    norm = np.empty(n)
+    for v in range(n):
+        x = math.sqrt(grad[v, 0] * grad[v, 0] + grad[v, 1] * grad[v, 1])
+        norm[v] = x
+        p = peak[label[v]]
+        if p == p and (x > p or x != x):
+            peak[label[v]] = x
+    moved = np.zeros(n, dtype=np.bool_)
+    for v in range(n):
+        g = peak[label[v]]
+        if movable[v] and g > 0.0:
+            moved[v] = True
+            c = step / g
+            uv[v, 0] -= c * grad[v, 0]
+            uv[v, 1] -= c * grad[v, 1]
+    return moved

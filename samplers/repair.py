@@ -56,7 +56,9 @@ from ._repair_kernels import (
     canonical_order,
     centroids,
     delaunay_flips,
+    descent_step,
     energy_terms,
+    gathered_gradient,
     same_points,
 )
 
@@ -404,14 +406,6 @@ def canonical_triangles(pts: np.ndarray, simplices: np.ndarray, neighbors: np.nd
     return (*canonical_order(tri, nbr), float(np.abs(area).min()) if area.size else 0.0)
 
 
-def _summed(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
-    """(n, 2): ``values`` added up per ``index``, one after another in their
-    order from zero (what ``np.add.at`` on zeros gives, bit for bit)."""
-    return np.stack(
-        [np.bincount(index, weights=values[:, j], minlength=n) for j in range(2)], axis=1
-    )
-
-
 def _energy(prob: _Problem, subset=None, active=None, watch=None):
     """Energy, its gradient on the samples, the ratios, the triangles (as
     sample ids) and their corners' positions (the terms:
@@ -443,11 +437,9 @@ def _energy(prob: _Problem, subset=None, active=None, watch=None):
         prob.wide,
     )
     tri = tri[rows]
-    real = of >= 0
     if prob.turn is not None:  # an image's gradient, turned back onto its sample
         gp = rotate(gp, -turned)
-    grad = _summed(of[real], gp[real], grad.shape[0])
-    grad[~move] = 0.0
+    grad = gathered_gradient(of, gp, grad.shape[0], move)
     return energy, grad, rho, of[tri], pts[tri]
 
 
@@ -464,9 +456,11 @@ def _descend(prob: _Problem, steps: int, subset=None, active=None, centres=None)
 
 def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
     h = prob.h
-    label = None
+    regions = 1
+    label = np.zeros(prob.uv.shape[0], dtype=np.int64)
     if centres is not None and len(centres) > 1:
-        _, label = cKDTree(np.asarray(centres)).query(prob.uv)
+        regions = len(centres)
+        label = cKDTree(np.asarray(centres)).query(prob.uv)[1].astype(np.int64)
     best, since = np.inf, 0
     for _ in range(steps):
         energy, grad, rho, _, _ = _energy(prob, subset, active)
@@ -479,17 +473,9 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
             since += 1
             if since >= 15:
                 return
-        norm = np.linalg.norm(grad, axis=1)
-        if label is None:
-            g = np.full(norm.size, norm.max())
-        else:
-            peak = np.zeros(len(centres))
-            np.maximum.at(peak, label, norm)
-            g = peak[label]
-        if not (g > 0.0).any():
+        move = descent_step(prob.uv, grad, prob.free | prob.slide, label, regions, STEP * h)
+        if not move.any():
             return
-        move = (prob.free | prob.slide) & (g > 0.0)
-        prob.uv[move] -= (STEP * h / g[move])[:, None] * grad[move]
         # back onto their curves and inside the face: the samples that moved
         slid = move & prob.slide
         if slid.any():

@@ -336,19 +336,40 @@ def test_a_stuck_repair_is_retried_and_never_ends_worse(monkeypatch):
 
 def test_the_repairs_vectorised_sums_and_edges_keep_the_bits():
     """The repair's per-step geometry is computed for all slanted edges at
-    once and its gradient summed with one bincount; both must give the bits
-    of the one-at-a-time code they replaced (np.add.at term by term, each
-    edge's own ``along``/``distance``/``project``), or a sampling would move."""
+    once, its gradient summed per sample and its step taken in numba
+    kernels; all must give the bits of the one-at-a-time code they replaced
+    (np.add.at term by term, the step's norms and per-region peaks in
+    numpy, each edge's own ``along``/``distance``/``project``), or a
+    sampling would move."""
     from sr33.samplers import layers
-    from sr33.samplers import repair as rp
+    from sr33.samplers._repair_kernels import descent_step, gathered_gradient
 
     rng = np.random.default_rng(3)
-    index = rng.integers(0, 40, 500)
+    index = rng.integers(-2, 40, 500)  # ghosts (-1) and frame points (-2) among them
     values = rng.normal(size=(500, 2)) * 10.0 ** rng.integers(-8, 3, (500, 1))
+    move = rng.random(40) < 0.7
     expected = np.zeros((40, 2))
-    for part in np.array_split(np.arange(500), 7):  # several add.at calls in a row
+    real = np.flatnonzero(index >= 0)
+    for part in np.array_split(real, 7):  # several add.at calls in a row
         np.add.at(expected, index[part], values[part])
-    assert rp._summed(index, values, 40).tobytes() == expected.tobytes()
+    expected[~move] = 0.0
+    assert gathered_gradient(index, values, 40, move).tobytes() == expected.tobytes()
+    # a descent step: per region, the largest move is the step
+    for regions in (1, 3):
+        uv = rng.normal(size=(40, 2))
+        grad = values[:40] * (rng.random((40, 1)) < 0.9)
+        label = rng.integers(0, regions, 40)
+        norm = np.linalg.norm(grad, axis=1)
+        peak = np.zeros(regions)
+        np.maximum.at(peak, label, norm)
+        g = peak[label]
+        want = uv.copy()
+        m = move & (g > 0.0)
+        want[m] -= (0.02 / g[m])[:, None] * grad[m]
+        got = uv.copy()
+        moved = descent_step(got, grad, move, label, regions, 0.02)
+        np.testing.assert_array_equal(moved, m)
+        assert got.tobytes() == want.tobytes()
 
     def line(a, b):
         a, b = np.asarray(a, float), np.asarray(b, float)
