@@ -797,6 +797,8 @@ def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8, curvature
         if uncrossed is not None:
             edges, cross, tri = uncrossed
             q = _quads(tri, edges, n)
+            if q.size == 0:
+                break
         pairs = np.sort(
             np.concatenate([q[:, [0, 1]], q[:, [0, 2]], q[:, [1, 2]], q[:, [0, 3]], q[:, [1, 3]]]),
             axis=1,
