@@ -47,7 +47,7 @@ from scipy.spatial import cKDTree
 
 from sr33.mesh import dot
 
-from .faces import RIM_SAMPLED, Stereographic, basis_surface, goes_round, steps, whole_band
+from .faces import RIM_SAMPLED, Stereographic, basis_surface, goes_round, steps
 from .layers import POLE_GOOD, RASTER, STUCK, lattice_revolved_body, unstuck
 from .repair import repair
 from .samples import Samples
@@ -603,7 +603,7 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
             continue  # a smooth edge: the face blends into its neighbour
         if kind == "SPHERE":
             spheres.append((fi, face, rim_lines(rims, h)))
-        elif not whole_band(face):
+        else:  # a whole band only where no layout took it (it is in skip otherwise)
             cylinders.append((fi, face, rim_lines(rims, h)))
     views: dict[int, list[_View]] = {}  # per face, its chart (a cylinder's: per cut)
     wide = []
