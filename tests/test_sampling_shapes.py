@@ -1595,6 +1595,35 @@ def test_a_whole_wall_between_two_rims_that_disagree_is_repaired_in_its_chart():
     assert np.nanmax(ratio) < 0.85
 
 
+def test_a_frustums_rings_take_the_phase_of_its_small_rim():
+    """A cone frustum (0.5 -> 0.25, 0.5 high) drilled through (0.1): its
+    small rim is the top annulus's, laid in rings round the hole with 62
+    samples; the frustum's rings, halving by their gaps from the large rim,
+    reached it with 124 columns of another phase, and the development's
+    repair against the fixed rim was stuck: 110 samples at or above 0.85,
+    worst 0.964 (91 s).  The rings near the small rim take its phase
+    (:func:`sr33.samplers.layers._phased`)."""
+    import cadquery as cq
+
+    from sr33.samplers.layers import _phased
+
+    rim = np.array([0.3, 1.9, 4.0])
+    got = _phased(np.linspace(0.0, 6.0, 12), rim)  # 12 = 3 x 4: each rim gap split in 4
+    np.testing.assert_allclose(got[::4], rim)
+    np.testing.assert_allclose(got[1:4], 0.3 + 1.6 * np.array([0.25, 0.5, 0.75]))
+    odd = np.linspace(0.0, 6.0, 9)  # 9 = 3 x 3: not a power of two, left as it is
+    assert _phased(odd, rim) is odd
+
+    solid = cq.Solid.makeCone(0.5, 0.25, 0.5).cut(cq.Solid.makeCylinder(0.1, 0.5))
+    s = shapes.from_cad(solid, name="drilled frustum")
+    cone = [i for i, f in enumerate(s.solid.Faces()) if f.geomType() == "CONE"]
+    assert len(cone) == 1
+    r, ratio = _geodesic_ratios(s, None)
+    assert (cone[0], "cone rings") in {(x.get("face"), x["kind"]) for x in r.meta["repairs"]}
+    assert abs(r.meta["spacing"] - 0.02) < 1e-12  # the spacing the rings were stuck at
+    assert np.nanmax(ratio) < 0.85
+
+
 def test_an_unrolled_cylinder_is_an_isometry_and_its_raster_wraps():
     """:class:`sr33.samplers.outlines.Unrolled` maps a cylinder onto the
     plane keeping lengths along it (arc length round, height along), and
