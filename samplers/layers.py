@@ -1351,8 +1351,8 @@ def _phased(ang: np.ndarray, rim: np.ndarray) -> np.ndarray:
         return ang
     low = np.sort(rim % (2 * math.pi))
     nxt = np.r_[low[1:], low[0] + 2 * math.pi]
-    steps_ = (low[:, None] + (nxt - low)[:, None] * (np.arange(split) / split)[None, :]).ravel()
-    return steps_ % (2 * math.pi)
+    split_gaps = (low[:, None] + (nxt - low)[:, None] * (np.arange(split) / split)[None, :]).ravel()
+    return split_gaps % (2 * math.pi)
 
 
 def _rings_judged(got, rim_ang, slant: float, sin_a: float, t: float, inner) -> float:
