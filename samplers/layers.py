@@ -1099,17 +1099,25 @@ def _developed(rho, ang, sin_a: float) -> np.ndarray:
     return np.stack([rho * np.cos(psi), rho * np.sin(psi)], axis=1)
 
 
-def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) -> float:
+def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float, inner=None) -> float:
     """The worst Condition III-ii ratio of a cone's rings on its development,
     away from the glued sides (``APEX_JUDGED_SIDE`` t) and from the apex
     (``APEX_JUDGED_FROM`` t): the Delaunay triangles of the samples (the
     rim's and the apex included) laid out at polar coordinates
     ``(rho, ang sin(a))``.  The development's repair reports only the
     triangles it mended; this judges every ring (a cone of radius 0.37 by
-    height 0.8: 0.846 reported, 0.865 here and by the geodesic check)."""
+    height 0.8: 0.846 reported, 0.865 here and by the geodesic check).  A
+    frustum's development ends at its small rim, ``inner`` = (its slant
+    distance, its samples' angles): those samples stand in for the apex
+    and no triangle inside that rim is judged (the apex's fan across the
+    hole read 1.0 on every drilled frustum)."""
     theta = 2 * math.pi * sin_a
     rim = _developed(slant, rim_ang, sin_a)
-    uv = np.vstack([_developed(rho, ang, sin_a), rim, np.zeros((1, 2))])  # the apex last
+    if inner is None:
+        end, hole = np.zeros((1, 2)), APEX_JUDGED_FROM * t  # the apex last
+    else:
+        end, hole = _developed(inner[0], inner[1], sin_a), inner[0]
+    uv = np.vstack([_developed(rho, ang, sin_a), rim, end])
     tri = Delaunay(uv).simplices
     c = uv[tri].mean(axis=1)
     rc = np.linalg.norm(c, axis=1)
@@ -1117,7 +1125,7 @@ def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float) ->
     judged = (
         (pc < theta)
         & (rc * np.minimum(pc, theta - pc) > APEX_JUDGED_SIDE * t)
-        & (rc > APEX_JUDGED_FROM * t)
+        & (rc > hole)
         & (rc < slant)
     )
     return float(np.r_[triangle_ratios(uv, tri[judged]), 0.0].max())
@@ -1359,7 +1367,7 @@ def _rings_judged(got, rim_ang, slant: float, sin_a: float, t: float, inner) -> 
     """The worst ratio of a cone's repaired rings ``got`` (rho, ang, ...): on
     the whole development (:func:`_developed_worst`) and, with an apex,
     round it (:func:`_apex_worst`)."""
-    judged = _developed_worst(got[0], got[1], rim_ang, slant, sin_a, t)
+    judged = _developed_worst(got[0], got[1], rim_ang, slant, sin_a, t, inner)
     if inner is None:
         judged = max(judged, _apex_worst(got[0], got[1], rim_ang, slant, sin_a, t))
     return judged

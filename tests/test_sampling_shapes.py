@@ -1602,7 +1602,8 @@ def test_a_frustums_rings_take_the_phase_of_its_small_rim():
     reached it with 124 columns of another phase, and the development's
     repair against the fixed rim was stuck: 110 samples at or above 0.85,
     worst 0.964 (91 s).  The rings near the small rim take its phase
-    (:func:`sr33.samplers.layers._phased`)."""
+    (:func:`sr33.samplers.layers._phased`), and the rings' judge ends at
+    the small rim."""
     import cadquery as cq
 
     from sr33.samplers.layers import _phased
@@ -1619,9 +1620,14 @@ def test_a_frustums_rings_take_the_phase_of_its_small_rim():
     cone = [i for i, f in enumerate(s.solid.Faces()) if f.geomType() == "CONE"]
     assert len(cone) == 1
     r, ratio = _geodesic_ratios(s, None)
-    assert (cone[0], "cone rings") in {(x.get("face"), x["kind"]) for x in r.meta["repairs"]}
+    rings = [x for x in r.meta["repairs"] if x["kind"] == "cone rings"]
+    assert [x["face"] for x in rings] == cone
     assert abs(r.meta["spacing"] - 0.02) < 1e-12  # the spacing the rings were stuck at
     assert np.nanmax(ratio) < 0.85
+    # the rings' own judge agrees with the check on the cone (it judged the
+    # apex's fan across the hole: 1.0 on every drilled frustum)
+    on_cone = r.face_id == cone[0]
+    assert abs(rings[0]["judged"] - np.nanmax(ratio[on_cone])) < 0.01
 
 
 def test_an_unrolled_cylinder_is_an_isometry_and_its_raster_wraps():
