@@ -498,10 +498,8 @@ def descent_step(uv, grad, movable, label, regions, step):
     per region from zero, ``uv[move] -= (step / g)[:, None] * grad``."""
     n = uv.shape[0]
     peak = np.zeros(regions)
-    norm = np.empty(n)
     for v in range(n):
         x = math.sqrt(grad[v, 0] * grad[v, 0] + grad[v, 1] * grad[v, 1])
-        norm[v] = x
         p = peak[label[v]]
         if p == p and (x > p or x != x):
             peak[label[v]] = x

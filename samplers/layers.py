@@ -1099,6 +1099,15 @@ def _developed(rho, ang, sin_a: float) -> np.ndarray:
     return np.stack([rho * np.cos(psi), rho * np.sin(psi)], axis=1)
 
 
+def _development_end(inner, sin_a: float) -> tuple[np.ndarray, float]:
+    """Where a cone's development ends inside: the apex at the origin
+    (radius 0), or a frustum's small rim, ``inner`` = (its slant distance,
+    its samples' angles), laid out with its radius."""
+    if inner is None:
+        return np.zeros((1, 2)), 0.0
+    return _developed(inner[0], inner[1], sin_a), inner[0]
+
+
 def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float, inner=None) -> float:
     """The worst Condition III-ii ratio of a cone's rings on its development,
     away from the glued sides (``APEX_JUDGED_SIDE`` t) and from the apex
@@ -1113,10 +1122,9 @@ def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float, in
     hole read 1.0 on every drilled frustum)."""
     theta = 2 * math.pi * sin_a
     rim = _developed(slant, rim_ang, sin_a)
+    end, hole = _development_end(inner, sin_a)  # last
     if inner is None:
-        end, hole = np.zeros((1, 2)), APEX_JUDGED_FROM * t  # the apex last
-    else:
-        end, hole = _developed(inner[0], inner[1], sin_a), inner[0]
+        hole = APEX_JUDGED_FROM * t
     uv = np.vstack([_developed(rho, ang, sin_a), rim, end])
     tri = Delaunay(uv).simplices
     c = uv[tri].mean(axis=1)
@@ -1291,9 +1299,9 @@ def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float,
     if inner is not None:
         # the rings near the small rim take its phase (the rim's angles are
         # another layout's); the change of phase falls between free rings
-        reach = min(2.0 * MOVABLE * t, 0.5 * (slant - inner[0]))
+        near_rim = min(2.0 * MOVABLE * t, 0.5 * (slant - inner[0]))
         for k, rho in enumerate(rho_l):
-            if rho[0] - inner[0] <= reach:
+            if rho[0] - inner[0] <= near_rim:
                 ang_l[k] = _phased(ang_l[k], inner[1])
     keep = APEX_KEEP
     fan = _apex_fan(2 * math.pi * sin_a) if rho_l and inner is None else None
@@ -1690,12 +1698,8 @@ def _repair_developed(
     theta = 2 * math.pi * sin_a
     uv = _developed(rho, ang, sin_a)
     rim = _developed(slant, rim_ang, sin_a)
-    if inner is None:
-        allp = np.vstack([uv, rim, np.zeros((1, 2))])
-        hole = 0.0
-    else:
-        hole, low_ang = inner
-        allp = np.vstack([uv, rim, _developed(hole, low_ang, sin_a)])
+    end, hole = _development_end(inner, sin_a)
+    allp = np.vstack([uv, rim, end])
 
     def inside(c: np.ndarray) -> np.ndarray:
         r = np.linalg.norm(c, axis=1)

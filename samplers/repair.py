@@ -364,6 +364,14 @@ def _delaunay(prob: _Problem, pts: np.ndarray, of: np.ndarray) -> np.ndarray:
     return tri
 
 
+def _doubled_areas(pts: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Twice each triangle's signed area (positive counter-clockwise)."""
+    p = pts[tri]
+    return (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 1, 1] - p[:, 0, 1]) * (
+        p[:, 2, 0] - p[:, 0, 0]
+    )
+
+
 def _without_flat_hull(pts: np.ndarray, simplices: np.ndarray, neighbors: np.ndarray, tol):
     """Qhull's triangles less the flat ones (twice the area at most ``tol``)
     on the hull, with the neighbours renumbered.
@@ -375,11 +383,7 @@ def _without_flat_hull(pts: np.ndarray, simplices: np.ndarray, neighbors: np.nda
     the triangulation could not be carried to the next step (its check
     wants every triangle turning counter-clockwise): 17,000 of conebox
     turned a's 28,000 Qhull calls."""
-    p = pts[simplices]
-    area = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 1, 1] - p[:, 0, 1]) * (
-        p[:, 2, 0] - p[:, 0, 0]
-    )
-    drop = (np.abs(area) <= tol) & (neighbors < 0).any(axis=1)
+    drop = (np.abs(_doubled_areas(pts, simplices)) <= tol) & (neighbors < 0).any(axis=1)
     if not drop.any():
         return simplices, neighbors
     new = np.cumsum(~drop) - 1
@@ -396,10 +400,7 @@ def canonical_triangles(pts: np.ndarray, simplices: np.ndarray, neighbors: np.nd
     order, so that its bits depend on the triangles only."""
     tri = np.asarray(simplices, dtype=np.int64).copy()
     nbr = np.asarray(neighbors, dtype=np.int64).copy()
-    p = pts[tri]
-    area = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 1, 1] - p[:, 0, 1]) * (
-        p[:, 2, 0] - p[:, 0, 0]
-    )
+    area = _doubled_areas(pts, tri)
     cw = area < 0
     tri[cw] = tri[cw][:, [0, 2, 1]]
     nbr[cw] = nbr[cw][:, [0, 2, 1]]
@@ -411,9 +412,8 @@ def _energy(prob: _Problem, subset=None, active=None, watch=None):
     sample ids) and their corners' positions (the terms:
     :func:`sr33.samplers._repair_kernels.energy_terms`)."""
     pts, of, turned, tri = _triangles(prob, subset)
-    grad = np.zeros_like(prob.uv)
     if tri.shape[0] == 0:
-        return 0.0, grad, np.empty(0), tri, pts[tri]
+        return 0.0, np.zeros_like(prob.uv), np.empty(0), tri, pts[tri]
     # triangles on a ghost are not the face's; those on the frame are, when they
     # have a movable sample (the rest of the frame's cannot change); judged,
     # those with a watched (and active) sample
@@ -439,7 +439,7 @@ def _energy(prob: _Problem, subset=None, active=None, watch=None):
     tri = tri[rows]
     if prob.turn is not None:  # an image's gradient, turned back onto its sample
         gp = rotate(gp, -turned)
-    grad = gathered_gradient(of, gp, grad.shape[0], move)
+    grad = gathered_gradient(of, gp, prob.uv.shape[0], move)
     return energy, grad, rho, of[tri], pts[tri]
 
 
@@ -462,6 +462,7 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
         regions = len(centres)
         label = cKDTree(np.asarray(centres)).query(prob.uv)[1].astype(np.int64)
     best, since = np.inf, 0
+    movable = prob.free | prob.slide  # the roles stay through a descent
     for _ in range(steps):
         energy, grad, rho, _, _ = _energy(prob, subset, active)
         if rho.size == 0 or rho.max() < TARGET + 0.02:
@@ -473,7 +474,7 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
             since += 1
             if since >= 15:
                 return
-        move = descent_step(prob.uv, grad, prob.free | prob.slide, label, regions, STEP * h)
+        move = descent_step(prob.uv, grad, movable, label, regions, STEP * h)
         if not move.any():
             return
         # back onto their curves and inside the face: the samples that moved

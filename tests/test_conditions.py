@@ -246,6 +246,20 @@ def test_chords_stand_for_geodesics_only_where_the_patch_is_flat_between():
     assert _chord_ok(patches, np.array([mid]), np.array([mid + 1]))[0]
 
 
+class _PlaneGeodesics:
+    """The angle test's lengths for samples in a plane: straight chords,
+    all ``exact`` or none."""
+
+    def __init__(self, pts, exact: bool):
+        self.pts, self.is_exact = pts, exact
+
+    def __call__(self, pairs):
+        return np.linalg.norm(self.pts[pairs[:, 0]] - self.pts[pairs[:, 1]], axis=1)
+
+    def exact(self, pairs):
+        return np.full(pairs.shape[0], self.is_exact)
+
+
 @pytest.mark.parametrize(
     "height, crossings, exact, flipped",
     [
@@ -273,14 +287,7 @@ def test_edges_plainly_not_delaunay_are_flipped(height, crossings, exact, flippe
     cross = np.array([crossings, 40, 40, 40, 40])
     tri = np.array([[0, 1, 2], [0, 1, 3]])
 
-    class Geodesics:
-        def __call__(self, pairs):
-            return np.linalg.norm(pts[pairs[:, 0]] - pts[pairs[:, 1]], axis=1)
-
-        def exact(self, pairs):
-            return np.full(pairs.shape[0], exact)
-
-    e, _, t = _flip_to_delaunay(pts, (edges, cross, tri), Geodesics())
+    e, _, t = _flip_to_delaunay(pts, (edges, cross, tri), _PlaneGeodesics(pts, exact))
     got = {tuple(x) for x in e.tolist()}
     assert ((2, 3) in got, (0, 1) in got) == (flipped, not flipped)
     assert len(got) == 5
@@ -312,14 +319,7 @@ def test_crossed_diagonals_of_a_near_tie_keep_the_delaunay_pair(dy, delaunay, ex
     edges = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
     cross = np.full(6, 3)
 
-    class Geodesics:
-        def __call__(self, pairs):
-            return np.linalg.norm(pts[pairs[:, 0]] - pts[pairs[:, 1]], axis=1)
-
-        def exact(self, pairs):
-            return np.ones(pairs.shape[0], dtype=bool)
-
-    e, c, t = _flip_to_delaunay(pts, (edges, cross, tri), Geodesics())
+    e, c, t = _flip_to_delaunay(pts, (edges, cross, tri), _PlaneGeodesics(pts, True))
     got = {tuple(x) for x in e.tolist()}
     assert len(c) == len(e) == 5
     if delaunay == "cd":
@@ -334,7 +334,7 @@ def test_crossed_diagonals_of_a_near_tie_keep_the_delaunay_pair(dy, delaunay, ex
     tri5 = np.vstack([tri, [2, 3, 4]])
     edges5 = np.vstack([edges, [[2, 4], [3, 4]]])
     q = _quads(tri5, edges5, 5)
-    assert _uncrossed(q, edges5, np.full(8, 3), tri5, Geodesics(), 5) is None
+    assert _uncrossed(q, edges5, np.full(8, 3), tri5, _PlaneGeodesics(pts, True), 5) is None
 
 
 def test_conditions_command_exits_1_when_a_condition_fails(plane, tmp_path, capsys):

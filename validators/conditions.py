@@ -694,6 +694,22 @@ def _cell_curvature(tv, tf, label, snap, n: int) -> np.ndarray:
     return np.bincount(label[ok], weights=defect[ok], minlength=n)
 
 
+def _quad_lengths(q: np.ndarray, geodesics: _Geodesics, with_cd: bool = False):
+    """The sorted pairs (a, b), (a, c), (b, c), (a, d), (b, d), and with
+    ``with_cd`` (c, d), of quads ``q`` = (a, b, c, d) (one block of rows per
+    pair), and their geodesic lengths, one row per pair."""
+    cols = ((0, 1), (0, 2), (1, 2), (0, 3), (1, 3)) + (((2, 3),) if with_cd else ())
+    pairs = np.sort(np.concatenate([q[:, list(c)] for c in cols]), axis=1)
+    return pairs, geodesics(pairs).reshape(len(cols), -1)
+
+
+def _excess(ab, ac, bc, ad, bd) -> np.ndarray:
+    """The angles at c and d facing (a, b), each of its triangle developed
+    flat from the lengths, summed, less π: above 0 the edge (a, b) is not
+    locally Delaunay."""
+    return _angle(ac, bc, ab) + _angle(ad, bd, ab) - np.pi
+
+
 def _uncrossed(q, edges, cross, tri, geodesics: _Geodesics, n: int):
     """DT_M with its crossed quads undone, or None without any.
 
@@ -719,13 +735,7 @@ def _uncrossed(q, edges, cross, tri, geodesics: _Geodesics, n: int):
     crossed = q[np.isin(cd, code)]
     if crossed.shape[0] == 0:
         return None
-    pairs = np.sort(
-        np.concatenate(
-            [crossed[:, [i, j]] for i, j in ((0, 1), (0, 2), (1, 2), (0, 3), (1, 3), (2, 3))]
-        ),
-        axis=1,
-    )
-    ab, ac, bc, ad, bd, cd_len = geodesics(pairs).reshape(6, -1)
+    _, (ab, ac, bc, ad, bd, cd_len) = _quad_lengths(crossed, geodesics, with_cd=True)
     # (a, b) is a diagonal of the four when c and d lie on either side of it:
     # the angle c-a-d is the sum of c-a-b and b-a-d, not their difference
     at_c, at_d = _angle(ab, ac, bc), _angle(ab, ad, bd)
@@ -733,7 +743,7 @@ def _uncrossed(q, edges, cross, tri, geodesics: _Geodesics, n: int):
     apart = np.minimum(np.abs(cad - (at_c + at_d)), np.abs(2.0 * np.pi - at_c - at_d - cad))
     diagonal = apart < np.abs(cad - np.abs(at_c - at_d))
     crossed = crossed[diagonal]
-    to_cd = (_angle(ac, bc, ab) + _angle(ad, bd, ab) > np.pi)[diagonal]
+    to_cd = (_excess(ab, ac, bc, ad, bd) > 0.0)[diagonal]
     drop = np.zeros(tri.shape[0], dtype=bool)
     gone_edges: list[int] = []
     new_tri: list[tuple[int, int, int]] = []
@@ -799,15 +809,11 @@ def _flip_to_delaunay(pts, dt, geodesics: _Geodesics, rounds: int = 8, curvature
             q = _quads(tri, edges, n)
             if q.size == 0:
                 break
-        pairs = np.sort(
-            np.concatenate([q[:, [0, 1]], q[:, [0, 2]], q[:, [1, 2]], q[:, [0, 3]], q[:, [1, 3]]]),
-            axis=1,
-        )
-        ab, ac, bc, ad, bd = geodesics(pairs).reshape(5, -1)
+        pairs, (ab, ac, bc, ad, bd) = _quad_lengths(q, geodesics)
         exact = geodesics.exact(pairs).reshape(5, -1).all(axis=0)
         code = edges[:, 0] * n + edges[:, 1]
         tie = cross[np.searchsorted(code, q[:, 0] * n + q[:, 1])] <= TIE_CROSSINGS
-        excess = _angle(ac, bc, ab) + _angle(ad, bd, ab) - np.pi
+        excess = _excess(ab, ac, bc, ad, bd)
         cd = np.minimum(q[:, 2], q[:, 3]) * n + np.maximum(q[:, 2], q[:, 3])
         bar = np.full(q.shape[0], math.radians(FLIP_MARGIN))
         if curvature is not None:  # flat between (no curvature in the cells): exact
