@@ -57,6 +57,7 @@ from .faces import (
     steps,
     whole_band,
 )
+from .meridians import chained, plane_meridian, snapped, turns
 from .repair import (
     ATTEMPTS,
     BAD,
@@ -1786,7 +1787,14 @@ APEX_BROKEN = 0.85  # ... and mends the triangles from this ratio
 
 
 def _repair_pole(
-    ring, columns, faces, t: float, end: int, memo: dict | None = None, reach: int = 0
+    ring,
+    columns,
+    faces,
+    t: float,
+    end: int,
+    memo: dict | None = None,
+    reach: int = 0,
+    dist: list[float] | None = None,
 ):
     """Repair the rings round a pole of a body of revolution: a sphere's
     smooth pole or a cone's apex.
@@ -1809,7 +1817,14 @@ def _repair_pole(
     axis make the cone's angle 0.1° short); one repair with that margin
     throughout moved the apex's samples too, and the tip's reconstruction
     then closed a triangle across the cone 1.5 t from the apex (two
-    components).  ``reach`` (default ``POLE_REACH``) is the number of rows
+    components).  A disk's centre (a turned part's, with the rings'
+    distances ``dist`` from the pole) is repaired as a sphere's pole, its map
+    the plane's own; a second repair then takes in the ``POLE_ZONE`` rings
+    past it and mends the triangles from ``APEX_BROKEN`` on, the first
+    repair's rings near the pole (``APEX_SETTLED`` t) kept: there the rings
+    of the disk halve by design right past the first repair's rim (a stepped
+    shaft's base, 0.853 by the geodesic check at every reach without it).
+    ``reach`` (default ``POLE_REACH``) is the number of rows
     round the pole; the repair runs in units of the row step t, so that its
     path does not hinge on the last bits of t.  ``end`` 0 is the pole
     before the first ring, 1 the one
@@ -1834,8 +1849,12 @@ def _repair_pole(
         return [], [], [], None
     inner = order[: reach - 1]  # rings 1 .. reach - 1 steps from the pole
     rim = order[reach - 1]
-    if kind not in ("SPHERE", "CONE") or any(ring[j][0] != ring[rim][0] for j in inner):
+    if kind not in ("SPHERE", "CONE", "PLANE"):
+        return [], [], [], None
+    if kind != "PLANE" and any(ring[j][0] != ring[rim][0] for j in inner):
         return [], [], [], None  # the face ends before the rim: the map would cross faces
+    # (a disk's centre: its map is the plane's own out to the disk's rim, and
+    # a turned part's next face meets it smoothly there)
     # in units of the row step: the repair's path then does not hinge on the
     # last bits of t (a turned ball's t differs from the upright one's in its
     # last bit, and its poles' repair ended at 0.979 instead of 0.84)
@@ -1851,9 +1870,27 @@ def _repair_pole(
         rho[0], ang[0], row[0] = fan.ring(1.0, ang[0][0], inner[0])
         keep = FAN_KEEP
     rho_a, ang_a, row_a = np.concatenate(rho), np.concatenate(ang), np.concatenate(row)
+    zone: list[int] = []
+    if kind == "PLANE" and dist is not None and n > reach + POLE_ZONE + 1:
+        # the rim and the rings past it, while the map by distance and angle
+        # keeps their circles' lengths (to ``PLANE_MAP``: not across a fillet)
+        zone = order[reach - 1 : reach - 1 + POLE_ZONE]
+        fits = [
+            abs(ring[j][2] / dist[j] - 1.0) <= PLANE_MAP
+            for j in zone + [order[reach - 1 + POLE_ZONE]]
+        ]
+        zone = zone[: fits.index(False)] if False in fits else zone
+        rim2 = order[reach - 1 + len(zone)]
+        zone = zone if len(zone) > 1 else []
+    if zone:
+        z_rho = np.concatenate([np.full(columns[j].size, dist[j] / t) for j in zone])
+        z_ang = np.concatenate([columns[j] for j in zone])
+        z_row = np.concatenate([np.full(columns[j].size, j) for j in zone])
     # repaired with each sample's own index for its row, so that a pole whose
     # rings equal another's bit for bit (a ball's two poles) takes its answer
     key = (kind, sin_a, keep, reach, rho_a.tobytes(), ang_a.tobytes(), columns[rim].tobytes())
+    if zone:
+        key += (z_rho.tobytes(), z_ang.tobytes(), columns[rim2].tobytes(), dist[rim2] / t)
     if memo is not None and key in memo:
         r2, a2, own, bad, worst, margin = memo[key]
     else:
@@ -1868,12 +1905,29 @@ def _repair_pole(
             )
             # and round the apex by the cone's own Delaunay triangles
             margin.append(_apex_worst(r2, a2, columns[rim], float(reach), sin_a, 1.0))
+        if zone:  # a disk's centre: then its rings past the rim, with a margin
+            extra = rho_a.size + np.arange(z_rho.size)
+            r2, a2, own, *margin = _repair_developed(
+                np.r_[r2, z_rho],
+                np.r_[a2, z_ang],
+                np.r_[own, extra],
+                columns[rim2],
+                dist[rim2] / t,
+                1.0,
+                1.0,
+                APEX_SETTLED,
+                APEX_BROKEN,
+            )
+            margin.append(0.0)
         if memo is not None:
             memo[key] = (r2, a2, own, bad, worst, margin)
+    if zone:
+        row_a = np.r_[row_a, z_row]
+        inner = inner + zone
     row2 = np.where(own >= 0, row_a[np.maximum(own, 0)], -1)
     r2 = r2 * t
     report = {
-        "kind": "pole" if kind == "SPHERE" else "apex",
+        "kind": "apex" if kind == "CONE" else "pole",
         "face": int(ring[order[0]][0]),
         "samples": int(rho_a.size),
         "added": int((row2 < 0).sum()),
@@ -1888,6 +1942,10 @@ def _repair_pole(
     return inner, list(zip(r2.tolist(), a2.tolist())), row2.tolist(), report
 
 
+#: a disk centre's second repair takes in the rings whose radius is their
+#: distance from the pole to this part (its map by distance and angle keeps
+#: their lengths)
+PLANE_MAP = 0.03
 #: a revolved body's pole (a sphere's, a cone's apex) is judged with its rings
 #: this many steps t past the repaired ones
 POLE_ZONE = 5
@@ -1920,6 +1978,20 @@ def _sphere_zone_worst(pts: np.ndarray, face, pole: np.ndarray) -> float:
     return float(triangle_ratios(pts, tri).max()) if tri.shape[0] else 0.0
 
 
+def _polar_zone_worst(pts: np.ndarray, flat: np.ndarray) -> float:
+    """The worst Condition III-ii ratio of the Delaunay triangles of a
+    pole's samples ``pts`` on their map ``flat`` by distance and angle about
+    the pole (the plane's own round a disk's centre), the triangles with a
+    corner on the hull left out (as :func:`_sphere_zone_worst`)."""
+    if pts.shape[0] < 4:
+        return 0.0
+    d = Delaunay(flat)
+    hull = np.zeros(pts.shape[0], dtype=bool)
+    hull[np.unique(d.convex_hull)] = True
+    tri = d.simplices[~hull[d.simplices].any(axis=1)]
+    return float(triangle_ratios(pts, tri).max()) if tri.shape[0] else 0.0
+
+
 def _meridian(face, o, axis, count: int = 2000):
     """The face's meridian at u = umin: parameters v and (axial, radial) coordinates."""
     umin, _, vmin, vmax = face._uvBounds()
@@ -1931,7 +2003,9 @@ def _meridian(face, o, axis, count: int = 2000):
     return v, z, rho
 
 
-def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
+def lattice_revolved_body(
+    occ, s: Samples, h: float, size: float, turned: bool = False
+) -> list[dict]:
     """Lay a closed body of revolution out in rings that keep their columns.
 
     Applies when every face is a full cone, sphere or torus about one axis
@@ -1955,28 +2029,69 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     poles) stay; every other sample of the body is replaced (the seam's
     vertices are not features of the surface).  Each ring sample is the
     exact meridian point turned about the axis, so it lies on the surface.
+
+    With ``turned``, a turned part instead (and only that): its faces may
+    also be planes across the axis (disks, annuli) and cylinders, and its
+    circles sharp, so long as one circle off the axis is smooth (a fillet's
+    or a dome's, which the layouts of sharp-rimmed faces do not take: a
+    cylinder with a filleted rim, a capsule).  The meridian is chained from
+    the faces' profiles (:func:`sr33.samplers.meridians.chained`); a ring
+    stands on every sharp circle (the nearest moved there,
+    :func:`sr33.samplers.meridians.snapped`) and its samples are the
+    edge's (the feature samples there go); a disk's centre is a pole (a
+    sample is laid there), repaired as a sphere's (its map, by distance and
+    angle about the pole, is the plane's own).  Only a meridian from the
+    axis to the axis: a closed one (a drilled part) is left to the faces'
+    layouts, its annuli's cells near the hole trapezoids no repair mends.
     """
     faces = occ.Faces()
-    if not faces or any(f.geomType() not in ("CONE", "SPHERE", "TORUS") for f in faces):
+    kinds = [f.geomType() for f in faces]
+    revolved = ("CONE", "SPHERE", "TORUS")
+    if not faces:
         return []
-    if not all(goes_round(f) for f in faces):
+    if not turned:
+        if any(k not in revolved for k in kinds) or not all(goes_round(f) for f in faces):
+            return []
+    elif any(k not in revolved + ("PLANE", "CYLINDER") for k in kinds) or all(
+        k == "PLANE" for k in kinds
+    ):
         return []
     tol = 1e-7 * size
-    o, axis = revolution_axis(faces[0])
-    for f in faces[1:]:
+    round_faces = [f for f, k in zip(faces, kinds) if k != "PLANE"]
+    if not all(goes_round(f) for f in round_faces):
+        return []
+    o, axis = revolution_axis(round_faces[0])
+    for f in round_faces[1:]:
         p, d = revolution_axis(f)
         off = p - o
         if abs(abs(dot(d, axis)) - 1) > 1e-9 or norm(off - (dot(off, axis)) * axis) > tol:
             return []
     off_axis = np.linalg.norm(np.cross(s.points - o, axis), axis=1) > tol
-    if (s.on_feature & off_axis).sum() > len(occ.Vertices()):
-        return []  # a sampled edge off the axis: not a smooth body
-    # the meridian, face after face, from the lowest point along the axis
-    parts = [(fi, *_meridian(f, o, axis)) for fi, f in enumerate(faces)]
-    for k, (fi, v, z, rho) in enumerate(parts):
-        if z[0] > z[-1]:
-            parts[k] = (fi, v[::-1], z[::-1], rho[::-1])
-    parts.sort(key=lambda q: q[2][0])
+    sharp: list[float] = []
+    if not turned:
+        if (s.on_feature & off_axis).sum() > len(occ.Vertices()):
+            return []  # a sampled edge off the axis: not a smooth body
+        # the meridian, face after face, from the lowest point along the axis
+        parts = [(fi, *_meridian(f, o, axis)) for fi, f in enumerate(faces)]
+        for k, (fi, v, z, rho) in enumerate(parts):
+            if z[0] > z[-1]:
+                parts[k] = (fi, v[::-1], z[::-1], rho[::-1])
+        parts.sort(key=lambda q: q[2][0])
+    else:
+        parts = []
+        for fi, f in enumerate(faces):
+            got = (
+                plane_meridian(f, o, axis, 1e3 * tol)
+                if kinds[fi] == "PLANE"
+                else _meridian(f, o, axis)
+            )
+            if got is None:
+                return []
+            parts.append((fi, *got))
+        got = chained(parts, 1e3 * tol)
+        if got is None:
+            return []
+        parts, _ = got
     seg = [np.r_[0.0, np.cumsum(np.hypot(np.diff(q[2]), np.diff(q[3])))] for q in parts]
     starts = np.cumsum([0.0] + [x[-1] for x in seg[:-1]])
     total = float(starts[-1] + seg[-1][-1])
@@ -1987,6 +2102,35 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     )
     if not closed and (first[3][0] > tol or last[3][-1] > tol):
         return []  # the meridian neither closes nor ends on the axis
+    if turned and closed:
+        # a drilled part: its annuli's rings shrink fast towards the hole and
+        # their cells come out as trapezoids (0.887 where the rows halve by
+        # design), with no pole's repair to mend them; left to the faces' layouts
+        return []
+    if turned:
+        # the circles where the profiles meet: sharp where the sampler put
+        # feature samples (every feature sample off the axis on one of them),
+        # and one at least smooth (its seam's vertex aside)
+        q = s.points[s.on_feature & off_axis] - o
+        fz = dot(q, axis)
+        fr = np.linalg.norm(q - fz[:, None] * axis, axis=1)
+        claimed = np.zeros(fz.size, dtype=bool)
+        smooth = False
+        for at_s, _ in turns(parts, starts, closed):
+            k = int(np.clip(np.searchsorted(starts, at_s, side="right") - 1, 0, len(parts) - 1))
+            jz, jr = float(parts[k][2][0]), float(parts[k][3][0])
+            on = np.hypot(fz - jz, fr - jr) <= 1e-3 * h
+            if jr <= tol:
+                continue
+            claimed |= on
+            if on.sum() > 2:  # (a smooth circle's seam vertex is sampled as a corner)
+                sharp.append(at_s)
+            else:
+                smooth = True
+        if not smooth or not claimed.all():
+            return []
+        if not sharp and all(k in revolved for k in kinds):
+            return []  # the smooth body of revolution: laid after the faces' layouts
     rows = steps(total, h, least=2)
     t = total / rows
     umin = [f._uvBounds()[0] for f in faces]
@@ -1994,8 +2138,10 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     def at(sj: float) -> tuple[int, float, float]:
         """(face, axial, radial) of the meridian point at arc length ``sj``."""
         k = int(np.clip(np.searchsorted(starts, sj, side="right") - 1, 0, len(parts) - 1))
-        fi, v, _, _ = parts[k]
+        fi, v, zz, _ = parts[k]
         vj = float(np.interp(sj - starts[k], seg[k], v))
+        if kinds[fi] == "PLANE":  # its parameter is the radius
+            return fi, float(zz[0]), vj
         p = np.array(faces[fi]._geomAdaptor().Value(umin[fi], vj).Coord()) - o
         z = float(dot(p, axis))
         return fi, z, float(norm(p - z * axis))
@@ -2055,9 +2201,24 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
         cone tip with a ball of 0.4 and its apex 0.6 above, a reach of 8,
         59 samples 9-10 t from the apex at 0.876)."""
         plan = ring_positions(
-            mer_s, mer_r, t, m, closed=closed, keep=(0, 0) if closed else (reach, reach)
+            mer_s,
+            mer_r,
+            t,
+            m,
+            closed=closed,
+            keep=(0, 0) if closed else (reach, reach),
+            fixed=sharp,
         )
-        ring_at = [float((plan.origin + x) % total if closed else x) for x in plan.at]
+        pos, on_edges = plan.at, []
+        if sharp:
+            frozen = np.zeros(pos.size, dtype=bool)
+            if not closed:
+                frozen[:reach] = frozen[pos.size - reach :] = True
+            got = snapped(pos, [(x - plan.origin) % total for x in sharp], frozen, total, closed)
+            if got is None:
+                return None
+            pos, on_edges = got
+        ring_at = [float((plan.origin + x) % total if closed else x) for x in pos]
         ring = [at(x) for x in ring_at]
         radial = np.array([r for _, _, r in ring])
         widest = plan.widest
@@ -2077,7 +2238,19 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
                 ang = ang[::2]  # the ring round a pole: at most 5 columns (halving_count)
             columns[j] = ang
         repaired = [
-            (end, _repair_pole(ring, columns, faces, t, end, memo, reach))
+            (
+                end,
+                _repair_pole(
+                    ring,
+                    columns,
+                    faces,
+                    t,
+                    end,
+                    memo,
+                    reach,
+                    [x if end == 0 else total - x for x in ring_at] if turned else None,
+                ),
+            )
             for end in (() if closed else (0, 1))
         ]
         # what each repair was left with (an apex: after its second repair)
@@ -2087,6 +2260,11 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
             if rep is not None
         ]
         made = points(ring, ring_at, columns, repaired)
+        if on_edges:  # the rings on sharp circles are the edges' samples
+            edge_at = np.array([ring_at[j] for j in on_edges])
+            made = (*made[:5], np.isin(made[3], edge_at))
+        else:
+            made = (*made[:5], np.zeros(made[0].shape[0], dtype=bool))
         zones = []
         if not closed:
             for end in (0, 1):
@@ -2094,7 +2272,17 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
                 face = faces[part[0]]
                 near = made[3] if end == 0 else total - made[3]
                 pole = o + (part[2][0] if end == 0 else part[2][-1]) * axis
-                if face.geomType() == "SPHERE":
+                if face.geomType() == "PLANE":
+                    zone = near <= (reach + POLE_ZONE) * t + 1e-9 * t
+                    q = made[0][zone] - o
+                    ang = np.arctan2(dot(q, ey), dot(q, ex))
+                    flat = near[zone][:, None] * np.stack([np.cos(ang), np.sin(ang)], axis=1)
+                    zones.append(
+                        _polar_zone_worst(
+                            np.vstack([pole, made[0][zone]]), np.vstack([[0, 0], flat])
+                        )
+                    )
+                elif face.geomType() == "SPHERE":
                     zone = near <= (reach + POLE_ZONE) * t + 1e-9 * t
                     # the pole's own sample (on the axis, kept) among them
                     zones.append(_sphere_zone_worst(np.vstack([pole, made[0][zone]]), face, pole))
@@ -2123,19 +2311,28 @@ def lattice_revolved_body(occ, s: Samples, h: float, size: float) -> list[dict]:
     # the poles' repairs are a local search whose end depends on its input:
     # the first reach whose repairs end below POLE_GOOD and whose poles'
     # zones below ZONE_GOOD, else the best
-    reach, (made, rows, (_, zone_worst)) = _first_passing(
+    reach, got = _first_passing(
         POLE_REACHES if not closed else (POLE_REACH,),
         layout,
-        lambda x: x[-1][0] < POLE_GOOD and x[-1][1] < ZONE_GOOD,
-        lambda x: round(max(x[-1]), 6),
+        lambda x: x is not None and x[-1][0] < POLE_GOOD and x[-1][1] < ZONE_GOOD,
+        lambda x: math.inf if x is None else round(max(x[-1]), 6),
     )
-    new, ids, fids, _, reports = made
+    if got is None:
+        return []  # a sharp circle no ring could move onto
+    made, rows, (_, zone_worst) = got
+    new, ids, fids, _, reports, edge = made
+    if not closed:  # a disk's centre: a pole with no vertex there
+        for part, z in ((parts[0], parts[0][2][0]), (parts[-1], parts[-1][2][-1])):
+            if kinds[part[0]] == "PLANE":
+                new = np.vstack([new, o + z * axis])
+                ids, fids = np.r_[ids, -3], np.r_[fids, part[0]]
+                edge = np.r_[edge, False]
     s.replace(
         np.flatnonzero(off_axis),  # all but the apex and poles (seam vertices too)
         new,
         ids,
         fids,
-        np.zeros(new.shape[0], dtype=bool),
+        edge,
     )
     return [
         {

@@ -115,20 +115,55 @@ def _fill(length: float, t: float, first: float, last: float) -> list[float]:
     return [first] + [first + mid * k for k in range(1, n - 2)] + [length - last]
 
 
-def _side(s, rho, start: float, stop: float, step: float, columns: int, gap: float, rim: bool):
+#: a halving moved for a sharp circle keeps its gap within this (times the
+#: row step): the merged rectangles after it and the triangle of a dropped
+#: column then stay below 0.85 (``2x / sqrt(4x^2 + 1)`` at 0.78 is 0.843,
+#: ``sqrt(x^2 + 0.8^2) / 2x`` at 0.62 is 0.82)
+CORNER_GAPS = (0.62, 0.78)
+
+
+def _by_corner(s, rho, x: float, sign: float, step: float, columns: int, gap: float, fixed):
+    """Where a halving due at ``x`` stands when a sharp circle (arc lengths
+    ``fixed``) lies within a step of it: the circle must carry a ring, and
+    one a fraction of a step off the halving would make a short row.  The
+    halving itself stands on the circle, or a step before it (the circle
+    the ring after the halving), or the step before a halving
+    (``HALVING_STEPS``) before it (the circle the ring before): of those
+    whose gap stays within ``CORNER_GAPS``, the one nearest the design's.
+    Else ``x`` (the ring nearest the circle then moves onto it)."""
+    near = [f for f in fixed if abs(f - x) <= step]
+    if not near:
+        return x
+    f = min(near, key=lambda q: abs(q - x))
+    best, off = x, math.inf
+    for c in (f, f - sign * HALVING_STEPS[1] * step, f + sign * HALVING_STEPS[0] * step):
+        g = 2 * math.pi * float(np.interp(c, s, rho)) / columns / step
+        if CORNER_GAPS[0] <= g <= CORNER_GAPS[1] and abs(g - gap) < off:
+            best, off = c, abs(g - gap)
+    return best
+
+
+def _side(
+    s, rho, start: float, stop: float, step: float, columns: int, gap: float, rim: bool, fixed=()
+):
     """Rings from the one at ``start`` (the widest, excluded) to the one at
     ``stop`` (included), halving where the gap reaches ``gap`` row steps:
     {position: halves}, and how many halvings were moved.  Halvings stand
     two steps apart at least; one due within two steps of ``stop`` comes
     two steps before it (moved) where ``stop`` is a pole's ``rim`` (whose
     rings inside are repaired, not the rim), and is left out otherwise (the
-    narrowest ring of a torus, where the gap then stays just under ``gap``)."""
+    narrowest ring of a torus, where the gap then stays just under ``gap``).
+    A halving due within a step of a sharp circle (arc lengths ``fixed``)
+    moves so that a ring of its design stands on the circle
+    (:func:`_by_corner`)."""
     sign = 1.0 if stop >= start else -1.0
     anchors = [start]
     m = columns
     moved = 0
     while m >= 6:
         x = _crossing(s, rho, anchors[-1], stop, gap * step * m / (2 * math.pi))
+        if x is not None:
+            x = _by_corner(s, rho, x, sign, step, m, gap, fixed)
         if x is not None and rim and abs(stop - x) < 2 * step:
             x = stop - sign * 2 * step
             moved += 1
@@ -158,6 +193,7 @@ def ring_positions(
     closed: bool = False,
     keep: tuple[int, int] = (0, 0),
     gap: float = HALVING_GAP,
+    fixed=(),
 ) -> RingPlan:
     """Rings along a meridian, halving their columns where the gap is ``gap`` row steps.
 
@@ -180,6 +216,9 @@ def ring_positions(
         repaired); the rings between are designed.
     gap : float
         Gap (times ``step``) at which a ring's columns halve.
+    fixed : sequence of float
+        Arc lengths of sharp circles: a halving due within a step of one
+        stands on it (a turned part's, :mod:`sr33.samplers.meridians`).
 
     Returns
     -------
@@ -200,10 +239,19 @@ def ring_positions(
         order = np.argsort(ss, kind="stable")
         ss, rr = ss[order], rr[order]
         half = (ss >= 0.0) & (ss <= length)
-        narrow = float(ss[half][int(np.argmin(rr[half]))])
+        # the narrowest point; where the meridian runs at its least radius for
+        # a while (a drilled part's hole), the middle of that stretch, so that
+        # the columns coming either way halve alike before they meet there
+        hs, hr = ss[half], rr[half]
+        low = np.flatnonzero(hr <= hr.min() + 1e-9 * hr.max())
+        run = low[: int(np.argmax(np.diff(np.r_[low, low[-1] + 2]) > 1)) + 1]
+        narrow = float(hs[run[0]])
+        if hs[run[-1]] - hs[run[0]] > step:  # (a torus's narrowest point: the first)
+            narrow = float(0.5 * (hs[run[0]] + hs[run[-1]]))
         at = {0.0: False}
-        at.update(_side(ss, rr, 0.0, narrow, step, columns, gap, False)[0])
-        back = _side(ss, rr, 0.0, narrow - length, step, columns, gap, False)[0]
+        fx = [f - w + k * length for f in fixed for k in (-1, 0, 1)]
+        at.update(_side(ss, rr, 0.0, narrow, step, columns, gap, False, fx)[0])
+        back = _side(ss, rr, 0.0, narrow - length, step, columns, gap, False, fx)[0]
         for p, halves in back.items():
             if p - (narrow - length) > 1e-9 * step:  # the narrowest ring once
                 at[p + length] = halves
@@ -222,7 +270,7 @@ def ring_positions(
     at = {w: False}
     moved = 0
     for stop in (float(uniform[lo]), float(uniform[hi])):
-        side, k = _side(s, rho, w, stop, step, columns, gap, True)
+        side, k = _side(s, rho, w, stop, step, columns, gap, True, fixed)
         at.update(side)
         moved += k
     mid = sorted(at)

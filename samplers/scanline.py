@@ -1232,58 +1232,65 @@ def scan(
             from .spheres import repair_sphere_faces
 
             bag = Samples(points, line_id, face_id, on_feature)
-            laid: set[int] = set()  # faces laid out whole: no boundary-layer repair
-            for step, layout in (
-                ("pyramids", lattice_pyramid),
-                ("filleted boxes", lattice_filleted_box),
-                ("disks", lattice_disk_faces),
-                ("spherical caps", lattice_sphere_caps),
-            ):
-                with timed(f"sample: {step}"):
-                    more, done = layout(occ, bag, h, size)
+            with timed("sample: turned parts"):
+                # a turned part with a smooth circle (a fillet's, a dome's) is
+                # laid whole in rings along its meridian; nothing else is left
+                reports += lattice_revolved_body(occ, bag, h, size, turned=True)
+            if reports:
+                pbar.update(10)
+            else:
+                laid: set[int] = set()  # faces laid out whole: no boundary-layer repair
+                for step, layout in (
+                    ("pyramids", lattice_pyramid),
+                    ("filleted boxes", lattice_filleted_box),
+                    ("disks", lattice_disk_faces),
+                    ("spherical caps", lattice_sphere_caps),
+                ):
+                    with timed(f"sample: {step}"):
+                        more, done = layout(occ, bag, h, size)
+                    reports += more
+                    laid |= done
+                    pbar.update(1)
+                with timed("sample: developable bands"):
+                    more, banded = lattice_developable_bands(
+                        occ, bag, h, size, skip=laid, sharp_degrees=sharp_degrees, bands=chains
+                    )
                 reports += more
-                laid |= done
+                laid |= banded
                 pbar.update(1)
-            with timed("sample: developable bands"):
-                more, banded = lattice_developable_bands(
-                    occ, bag, h, size, skip=laid, sharp_degrees=sharp_degrees, bands=chains
-                )
-            reports += more
-            laid |= banded
-            pbar.update(1)
-            with timed("sample: planar faces"):
-                reports += repair_planar_faces(
-                    occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=laid, unfold=banded
-                )
-            with timed("sample: planar faces along square edges"):
-                # then the faces bounded by edges along or across their rows
-                # only, where their lattices stagger against an edge's samples
-                reports += repair_planar_faces(
-                    occ,
-                    bag,
-                    h,
-                    size,
-                    row_dirs=[dirs[f] for f in fam],
-                    skip=laid,
-                    squares=True,
-                    unfold=banded,
-                )
-            pbar.update(1)
-            for step, lay in (
-                ("cylinders", lattice_cylinder_faces),
-                ("cones", lattice_cone_faces),
-                ("bodies of revolution", lattice_revolved_body),
-                ("partial spheres", repair_sphere_faces),
-            ):
-                with timed(f"sample: {step}"):
-                    reports += lay(occ, bag, h, size)
+                with timed("sample: planar faces"):
+                    reports += repair_planar_faces(
+                        occ, bag, h, size, row_dirs=[dirs[f] for f in fam], skip=laid, unfold=banded
+                    )
+                with timed("sample: planar faces along square edges"):
+                    # then the faces bounded by edges along or across their rows
+                    # only, where their lattices stagger against an edge's samples
+                    reports += repair_planar_faces(
+                        occ,
+                        bag,
+                        h,
+                        size,
+                        row_dirs=[dirs[f] for f in fam],
+                        skip=laid,
+                        squares=True,
+                        unfold=banded,
+                    )
                 pbar.update(1)
-            with timed("sample: curved faces in their charts"):
-                # what no layout took: rims of any curve, seams (a boolean's pieces)
-                took = [f for x in reports for f in x.get("faces", [x.get("face")])]
-                handled = laid | {int(f) for f in took if f is not None}
-                reports += repair_curved_faces(occ, bag, h, size, skip=handled)
-            pbar.update(1)
+                for step, lay in (
+                    ("cylinders", lattice_cylinder_faces),
+                    ("cones", lattice_cone_faces),
+                    ("bodies of revolution", lattice_revolved_body),
+                    ("partial spheres", repair_sphere_faces),
+                ):
+                    with timed(f"sample: {step}"):
+                        reports += lay(occ, bag, h, size)
+                    pbar.update(1)
+                with timed("sample: curved faces in their charts"):
+                    # what no layout took: rims of any curve, seams (a boolean's pieces)
+                    took = [f for x in reports for f in x.get("faces", [x.get("face")])]
+                    handled = laid | {int(f) for f in took if f is not None}
+                    reports += repair_curved_faces(occ, bag, h, size, skip=handled)
+                pbar.update(1)
             points, line_id, face_id, on_feature = (
                 bag.points,
                 bag.line_id,
