@@ -1971,18 +1971,15 @@ def _sphere_zone_worst(pts: np.ndarray, face, pole: np.ndarray) -> float:
     sph = basis_surface(face).Sphere()
     centre = np.array(sph.Location().Coord())
     to2d = Stereographic(centre, float(sph.Radius()), (pole - centre) / norm(pole - centre))
-    d = Delaunay(to2d(pts))
-    hull = np.zeros(pts.shape[0], dtype=bool)
-    hull[np.unique(d.convex_hull)] = True
-    tri = d.simplices[~hull[d.simplices].any(axis=1)]
-    return float(triangle_ratios(pts, tri).max()) if tri.shape[0] else 0.0
+    return _zone_worst(pts, to2d(pts))
 
 
-def _polar_zone_worst(pts: np.ndarray, flat: np.ndarray) -> float:
+def _zone_worst(pts: np.ndarray, flat: np.ndarray) -> float:
     """The worst Condition III-ii ratio of the Delaunay triangles of a
-    pole's samples ``pts`` on their map ``flat`` by distance and angle about
-    the pole (the plane's own round a disk's centre), the triangles with a
-    corner on the hull left out (as :func:`_sphere_zone_worst`)."""
+    pole's samples ``pts`` on their map ``flat`` (a sphere's stereographic
+    one, :func:`_sphere_zone_worst`; by distance and angle about a disk's
+    centre, the plane's own), the triangles with a corner on the hull left
+    out (the zone's outer ring, whose circles may take in samples beyond)."""
     if pts.shape[0] < 4:
         return 0.0
     d = Delaunay(flat)
@@ -2278,9 +2275,7 @@ def lattice_revolved_body(
                     ang = np.arctan2(dot(q, ey), dot(q, ex))
                     flat = near[zone][:, None] * np.stack([np.cos(ang), np.sin(ang)], axis=1)
                     zones.append(
-                        _polar_zone_worst(
-                            np.vstack([pole, made[0][zone]]), np.vstack([[0, 0], flat])
-                        )
+                        _zone_worst(np.vstack([pole, made[0][zone]]), np.vstack([[0, 0], flat]))
                     )
                 elif face.geomType() == "SPHERE":
                     zone = near <= (reach + POLE_ZONE) * t + 1e-9 * t

@@ -162,7 +162,7 @@ def snapped(
     move = np.zeros(n)
     for (j0, d0), (j1, d1) in zip(ext[:-1], ext[1:]):
         for j in range(j0 + 1, j1):
-            if not (0 <= j % n < n) or (not closed and not 0 <= j < n):
+            if not closed and not 0 <= j < n:
                 continue
             if j1 - j0 <= 2 * SNAP_REACH:
                 x = d0 + (d1 - d0) * (j - j0) / (j1 - j0)

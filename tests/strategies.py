@@ -285,7 +285,7 @@ def _reject(reason: str) -> None:
 FOR_FEATURE = {
     "acute edge": (("cone", "frustum", "star prism"), ()),
     "cone apex": (("cone",), ()),
-    "smooth blend": (("box", "prism", "star prism"), ("fillet",)),
+    "smooth blend": (("box", "prism", "star prism", "cylinder", "frustum"), ("fillet",)),
     "chamfer": (("box", "prism", "cylinder"), ("chamfer",)),
     "hole": (("box", "prism", "cylinder", "torus"), ("hole",)),
     "boolean seam": (("box", "cylinder", "sphere", "prism"), ("union", "cut")),
@@ -310,7 +310,8 @@ def cad_models(draw, feature: str | None = None) -> CadModel:
     """A solid composed from primitives (box, cylinder, cone, frustum,
     sphere, torus, prisms over convex and star-shaped polygons), then up to
     two of: a union with a second primitive, a cut of one, a through hole,
-    fillets of the vertical edges, chamfers of the top edges (random sizes),
+    fillets of the vertical edges (of the top circles where there are none:
+    a turned body's rim), chamfers of the top edges (random sizes),
     then a random rigid motion.  Models CadQuery cannot build, that are not
     one valid solid, or whose truth mesh does not fit the B-rep are
     rejected (``assume``), each with its reason counted
@@ -359,11 +360,23 @@ def cad_models(draw, feature: str | None = None) -> CadModel:
                     for e in solid.Edges()
                     if e.geomType() == "LINE" and abs(e.tangentAt(0.5).z) > 0.999
                 ]
-                if not edges:
-                    continue
-                r = draw(st.floats(0.05, 0.2)) * min(e.Length() for e in edges)
-                new = solid.fillet(r, edges)
-                steps.append(f"fillet {len(edges)} vertical edges r {r!r}")
+                if edges:
+                    r = draw(st.floats(0.05, 0.2)) * min(e.Length() for e in edges)
+                    new = solid.fillet(r, edges)
+                    steps.append(f"fillet {len(edges)} vertical edges r {r!r}")
+                else:
+                    # a turned body (a cylinder, a cone): its top rim, a circle
+                    top = float(hi[2])
+                    edges = [
+                        e
+                        for e in solid.Edges()
+                        if e.geomType() == "CIRCLE" and abs(e.Center().z - top) < 1e-6
+                    ]
+                    if not edges:
+                        continue
+                    r = draw(st.floats(0.05, 0.2)) * float(min(ext))
+                    new = solid.fillet(r, edges)
+                    steps.append(f"fillet {len(edges)} top circles r {r!r}")
             else:
                 top = float(hi[2])
                 edges = [

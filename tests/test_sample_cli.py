@@ -85,7 +85,8 @@ def test_sampling_logs_every_step_at_debug_level(caplog):
         scan(shapes.build("cube"), 0.1, repair=False)
     steps = re.findall(r"sample: ([a-z ]+) took \d+\.\d+ s", caplog.text)
     first = ["feature samples", "scan rows", "gaps filled"]
-    repairs = ["pyramids", "filleted boxes", "disks", "spherical caps", "developable bands"]
+    repairs = ["turned parts", "pyramids", "filleted boxes", "disks", "spherical caps"]
+    repairs += ["developable bands"]
     repairs += ["planar faces"]
     repairs += ["planar faces along square edges", "cylinders", "cones"]
     repairs += ["bodies of revolution", "partial spheres", "curved faces in their charts"]
