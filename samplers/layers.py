@@ -1929,9 +1929,9 @@ def _repair_pole(
     report = {
         "kind": "apex" if kind == "CONE" else "pole",
         "face": int(ring[order[0]][0]),
-        "samples": int(rho_a.size),
+        "samples": int(row_a.size),  # (a disk centre's zone's too)
         "added": int((row2 < 0).sum()),
-        "removed": int(rho_a.size - (row2 >= 0).sum()),
+        "removed": int(row_a.size - (row2 >= 0).sum()),
         "bad": int(bad),
         "worst": float(worst),
     }
