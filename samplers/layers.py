@@ -57,7 +57,7 @@ from .faces import (
     steps,
     whole_band,
 )
-from .meridians import chained, plane_meridian, snapped, turns
+from .meridians import chained, junctions, plane_meridian, snapped
 from .repair import (
     ATTEMPTS,
     BAD,
@@ -2047,7 +2047,7 @@ def lattice_revolved_body(
     if not faces:
         return []
     if not turned:
-        if any(k not in revolved for k in kinds) or not all(goes_round(f) for f in faces):
+        if any(k not in revolved for k in kinds):
             return []
     elif any(k not in revolved + ("PLANE", "CYLINDER") for k in kinds) or all(
         k == "PLANE" for k in kinds
@@ -2113,7 +2113,7 @@ def lattice_revolved_body(
         fr = np.linalg.norm(q - fz[:, None] * axis, axis=1)
         claimed = np.zeros(fz.size, dtype=bool)
         smooth = False
-        for at_s, _ in turns(parts, starts, closed):
+        for at_s in junctions(parts, starts, closed):
             k = int(np.clip(np.searchsorted(starts, at_s, side="right") - 1, 0, len(parts) - 1))
             jz, jr = float(parts[k][2][0]), float(parts[k][3][0])
             on = np.hypot(fz - jz, fr - jr) <= 1e-3 * h

@@ -17,8 +17,6 @@ Plain numpy; the faces' profiles are read with OCP when the functions run.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from sr33.mesh import dot, norm
@@ -109,21 +107,14 @@ def chained(parts: list, tol: float):
     return order, closed
 
 
-def turns(parts: list, starts: np.ndarray, closed: bool) -> list[tuple[float, float]]:
-    """Where the meridian's direction jumps from one profile to the next: the
-    arc length of each junction (its end and the start of the next, and on
-    a closed meridian the last one's end into the first) and the angle it
-    turns by (radians)."""
-    out = []
+def junctions(parts: list, starts: np.ndarray, closed: bool) -> list[float]:
+    """The arc lengths where one profile ends and the next starts (on a
+    closed meridian, the last one's end into the first's start, at 0)."""
     count = len(parts)
-    for k in range(count if closed else count - 1):
-        a, b = parts[k], parts[(k + 1) % count]
-        u = np.array([a[2][-1] - a[2][-2], a[3][-1] - a[3][-2]])
-        w = np.array([b[2][1] - b[2][0], b[3][1] - b[3][0]])
-        cos = float(dot(u, w) / (norm(u) * norm(w)))
-        at = float(starts[k + 1]) if k + 1 < count else 0.0
-        out.append((at, math.acos(max(-1.0, min(1.0, cos)))))
-    return out
+    return [
+        float(starts[k + 1]) if k + 1 < count else 0.0
+        for k in range(count if closed else count - 1)
+    ]
 
 
 def snapped(

@@ -1237,7 +1237,7 @@ def scan(
                 # laid whole in rings along its meridian; nothing else is left
                 reports += lattice_revolved_body(occ, bag, h, size, turned=True)
             if reports:
-                pbar.update(10)
+                pbar.update(11)  # the steps skipped
             else:
                 laid: set[int] = set()  # faces laid out whole: no boundary-layer repair
                 for step, layout in (
