@@ -57,7 +57,7 @@ from .faces import (
     steps,
     whole_band,
 )
-from .meridians import chained, junctions, plane_meridian, snapped
+from .meridians import chained, plane_meridian, snapped
 from .repair import (
     ATTEMPTS,
     BAD,
@@ -2113,15 +2113,11 @@ def lattice_revolved_body(
         fr = np.linalg.norm(q - fz[:, None] * axis, axis=1)
         claimed = np.zeros(fz.size, dtype=bool)
         smooth = False
-        for at_s in junctions(parts, starts, closed):
-            k = int(np.clip(np.searchsorted(starts, at_s, side="right") - 1, 0, len(parts) - 1))
-            jz, jr = float(parts[k][2][0]), float(parts[k][3][0])
-            on = np.hypot(fz - jz, fr - jr) <= 1e-3 * h
-            if jr <= tol:
-                continue
+        for k in range(1, len(parts)):  # where profile k starts, off the axis
+            on = np.hypot(fz - parts[k][2][0], fr - parts[k][3][0]) <= 1e-3 * h
             claimed |= on
             if on.sum() > 2:  # (a smooth circle's seam vertex is sampled as a corner)
-                sharp.append(at_s)
+                sharp.append(float(starts[k]))
             else:
                 smooth = True
         if not smooth or not claimed.all():
@@ -2207,11 +2203,10 @@ def lattice_revolved_body(
             fixed=sharp,
         )
         pos, on_edges = plan.at, []
-        if sharp:
+        if sharp:  # (a turned part's meridian: open, from the axis to the axis)
             frozen = np.zeros(pos.size, dtype=bool)
-            if not closed:
-                frozen[:reach] = frozen[pos.size - reach :] = True
-            got = snapped(pos, [(x - plan.origin) % total for x in sharp], frozen, total, closed)
+            frozen[:reach] = frozen[pos.size - reach :] = True
+            got = snapped(pos, sharp, frozen)
             if got is None:
                 return None
             pos, on_edges = got
@@ -2257,11 +2252,8 @@ def lattice_revolved_body(
             if rep is not None
         ]
         made = points(ring, ring_at, columns, repaired)
-        if on_edges:  # the rings on sharp circles are the edges' samples
-            edge_at = np.array([ring_at[j] for j in on_edges])
-            made = (*made[:5], np.isin(made[3], edge_at))
-        else:
-            made = (*made[:5], np.zeros(made[0].shape[0], dtype=bool))
+        # the rings on sharp circles are the edges' samples
+        made = (*made, np.isin(made[3], [ring_at[j] for j in on_edges]))
         zones = []
         if not closed:
             for end in (0, 1):
@@ -2269,8 +2261,8 @@ def lattice_revolved_body(
                 face = faces[part[0]]
                 near = made[3] if end == 0 else total - made[3]
                 pole = o + (part[2][0] if end == 0 else part[2][-1]) * axis
+                zone = near <= (reach + POLE_ZONE) * t + 1e-9 * t
                 if face.geomType() == "PLANE":
-                    zone = near <= (reach + POLE_ZONE) * t + 1e-9 * t
                     q = made[0][zone] - o
                     ang = np.arctan2(dot(q, ey), dot(q, ex))
                     flat = near[zone][:, None] * np.stack([np.cos(ang), np.sin(ang)], axis=1)
@@ -2278,7 +2270,6 @@ def lattice_revolved_body(
                         _zone_worst(np.vstack([pole, made[0][zone]]), np.vstack([[0, 0], flat]))
                     )
                 elif face.geomType() == "SPHERE":
-                    zone = near <= (reach + POLE_ZONE) * t + 1e-9 * t
                     # the pole's own sample (on the axis, kept) among them
                     zones.append(_sphere_zone_worst(np.vstack([pole, made[0][zone]]), face, pole))
                 elif face.geomType() == "CONE":

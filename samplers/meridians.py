@@ -107,35 +107,21 @@ def chained(parts: list, tol: float):
     return order, closed
 
 
-def junctions(parts: list, starts: np.ndarray, closed: bool) -> list[float]:
-    """The arc lengths where one profile ends and the next starts (on a
-    closed meridian, the last one's end into the first's start, at 0)."""
-    count = len(parts)
-    return [
-        float(starts[k + 1]) if k + 1 < count else 0.0
-        for k in range(count if closed else count - 1)
-    ]
-
-
 def snapped(
-    at: np.ndarray, sharp: list[float], frozen: np.ndarray, length: float, closed: bool
+    at: np.ndarray, sharp: list[float], frozen: np.ndarray
 ) -> tuple[np.ndarray, list[int]] | None:
-    """Ring positions ``at`` (arc lengths, increasing) with a ring on every
-    sharp circle (arc lengths ``sharp``): the nearest ring moves onto it and
-    the ``SNAP_REACH`` rings either side follow it less and less (between
-    two moved rings nearer than twice that, the moves blend linearly).
-    Rings ``frozen`` (a pole's, whose repair wants them one step apart)
-    stay.  On a closed meridian (``length`` round) the distances wrap.
-    Returns the positions and the rings on the sharp circles, or None when
-    a sharp circle's nearest ring is frozen or nearest to another one too."""
+    """Ring positions ``at`` (arc lengths along a meridian from the axis to
+    the axis, increasing) with a ring on every sharp circle (arc lengths
+    ``sharp``): the nearest ring moves onto it and the ``SNAP_REACH`` rings
+    either side follow it less and less (between two moved rings nearer
+    than twice that, the moves blend linearly).  Rings ``frozen`` (a
+    pole's, whose repair wants them one step apart) stay.  Returns the
+    positions and the rings on the sharp circles, or None when a sharp
+    circle's nearest ring is frozen or nearest to another one too."""
     n = at.size
-    if not sharp:
-        return at.copy(), []
     knots: dict[int, float] = {}
     for f in sharp:
         d = f - at
-        if closed:
-            d = (d + 0.5 * length) % length - 0.5 * length
         j = int(np.argmin(np.abs(d)))
         if frozen[j] or j in knots:
             return None
@@ -143,29 +129,19 @@ def snapped(
     fixed = dict(knots)
     for j in np.flatnonzero(frozen):
         fixed[int(j)] = 0.0
-    idx = sorted(fixed)
-    if closed:
-        ext = [(j - n, fixed[j]) for j in idx] + [(j, fixed[j]) for j in idx]
-        ext += [(j + n, fixed[j]) for j in idx]
-    else:
-        ext = [(-SNAP_REACH - 1, 0.0)] + [(j, fixed[j]) for j in idx]
-        ext += [(n + SNAP_REACH, 0.0)]
+    ext = [(-SNAP_REACH - 1, 0.0)] + sorted(fixed.items()) + [(n + SNAP_REACH, 0.0)]
     move = np.zeros(n)
     for (j0, d0), (j1, d1) in zip(ext[:-1], ext[1:]):
-        for j in range(j0 + 1, j1):
-            if not closed and not 0 <= j < n:
-                continue
+        for j in range(max(j0 + 1, 0), min(j1, n)):
             if j1 - j0 <= 2 * SNAP_REACH:
                 x = d0 + (d1 - d0) * (j - j0) / (j1 - j0)
             else:
                 x = d0 * max(0.0, 1 - (j - j0) / SNAP_REACH)
                 x += d1 * max(0.0, 1 - (j1 - j) / SNAP_REACH)
-            move[j % n] = x
+            move[j] = x
     for j, d in fixed.items():
         move[j] = d
     out = at + move
-    if closed:
-        out = out % length
-    if not closed and (np.diff(out) <= 0).any():
+    if (np.diff(out) <= 0).any():
         return None
     return out, sorted(knots)

@@ -217,8 +217,9 @@ def ring_positions(
     gap : float
         Gap (times ``step``) at which a ring's columns halve.
     fixed : sequence of float
-        Arc lengths of sharp circles: a halving due within a step of one
-        stands on it (a turned part's, :mod:`sr33.samplers.meridians`).
+        On an open meridian, arc lengths of sharp circles: a halving due
+        within a step of one moves so that a ring of its design stands on
+        it (a turned part's, :mod:`sr33.samplers.meridians`).
 
     Returns
     -------
@@ -239,19 +240,10 @@ def ring_positions(
         order = np.argsort(ss, kind="stable")
         ss, rr = ss[order], rr[order]
         half = (ss >= 0.0) & (ss <= length)
-        # the narrowest point; where the meridian runs at its least radius for
-        # a while (a drilled part's hole), the middle of that stretch, so that
-        # the columns coming either way halve alike before they meet there
-        hs, hr = ss[half], rr[half]
-        low = np.flatnonzero(hr <= hr.min() + 1e-9 * hr.max())
-        run = low[: int(np.argmax(np.diff(np.r_[low, low[-1] + 2]) > 1)) + 1]
-        narrow = float(hs[run[0]])
-        if hs[run[-1]] - hs[run[0]] > step:  # (a torus's narrowest point: the first)
-            narrow = float(0.5 * (hs[run[0]] + hs[run[-1]]))
+        narrow = float(ss[half][int(np.argmin(rr[half]))])
         at = {0.0: False}
-        fx = [f - w + k * length for f in fixed for k in (-1, 0, 1)]
-        at.update(_side(ss, rr, 0.0, narrow, step, columns, gap, False, fx)[0])
-        back = _side(ss, rr, 0.0, narrow - length, step, columns, gap, False, fx)[0]
+        at.update(_side(ss, rr, 0.0, narrow, step, columns, gap, False)[0])
+        back = _side(ss, rr, 0.0, narrow - length, step, columns, gap, False)[0]
         for p, halves in back.items():
             if p - (narrow - length) > 1e-9 * step:  # the narrowest ring once
                 at[p + length] = halves

@@ -360,23 +360,19 @@ def cad_models(draw, feature: str | None = None) -> CadModel:
                     for e in solid.Edges()
                     if e.geomType() == "LINE" and abs(e.tangentAt(0.5).z) > 0.999
                 ]
-                if edges:
-                    r = draw(st.floats(0.05, 0.2)) * min(e.Length() for e in edges)
-                    new = solid.fillet(r, edges)
-                    steps.append(f"fillet {len(edges)} vertical edges r {r!r}")
-                else:
-                    # a turned body (a cylinder, a cone): its top rim, a circle
-                    top = float(hi[2])
+                what, scale = "vertical edges", min((e.Length() for e in edges), default=0.0)
+                if not edges:  # a turned body (a cylinder, a cone): its top rim, a circle
                     edges = [
                         e
                         for e in solid.Edges()
-                        if e.geomType() == "CIRCLE" and abs(e.Center().z - top) < 1e-6
+                        if e.geomType() == "CIRCLE" and abs(e.Center().z - float(hi[2])) < 1e-6
                     ]
-                    if not edges:
-                        continue
-                    r = draw(st.floats(0.05, 0.2)) * float(min(ext))
-                    new = solid.fillet(r, edges)
-                    steps.append(f"fillet {len(edges)} top circles r {r!r}")
+                    what, scale = "top circles", float(min(ext))
+                if not edges:
+                    continue
+                r = draw(st.floats(0.05, 0.2)) * scale
+                new = solid.fillet(r, edges)
+                steps.append(f"fillet {len(edges)} {what} r {r!r}")
             else:
                 top = float(hi[2])
                 edges = [

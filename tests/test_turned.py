@@ -42,14 +42,14 @@ def test_a_ring_moves_onto_a_sharp_circle_and_its_neighbours_follow_less():
     at = np.arange(1.0, 30.0)  # rings one step apart
     frozen = np.zeros(at.size, dtype=bool)
     frozen[:3] = True  # a pole's rings
-    pos, on = snapped(at, [15.4], frozen, 31.0, False)
+    pos, on = snapped(at, [15.4], frozen)
     assert on == [14] and pos[14] == 15.4
     assert (pos[frozen] == at[frozen]).all()
     moved = np.flatnonzero(pos != at)
     assert moved.min() == 14 - SNAP_REACH + 1 and moved.max() == 14 + SNAP_REACH - 1
     assert np.abs(np.diff(pos) - 1.0).max() <= 0.4 / SNAP_REACH + 1e-12  # steps barely change
-    assert snapped(at, [2.2], frozen, 31.0, False) is None  # on a pole's ring
-    assert snapped(at, [15.4, 15.45], frozen, 31.0, False) is None  # two circles, one ring
+    assert snapped(at, [2.2], frozen) is None  # on a pole's ring
+    assert snapped(at, [15.4, 15.45], frozen) is None  # two circles, one ring
 
 
 def test_a_halving_near_a_sharp_circle_puts_a_ring_of_its_design_on_it():
