@@ -16,6 +16,7 @@ from scipy.spatial import cKDTree
 
 from sr33.mesh import dot
 
+from . import _line_kernels as line_kernels
 from ._repair_kernels import grid_lookup
 
 ARC_MARGIN = 0.5  # free samples keep this far (times h) from a cylinder's rim (else h / 4)
@@ -45,8 +46,84 @@ class Raster:
         self.grid = grid
 
     def __call__(self, pts: np.ndarray) -> np.ndarray:
-        pts = np.ascontiguousarray(np.asarray(pts, dtype=np.float64).reshape(-1, 2))
-        return grid_lookup(pts, self.lo, float(self.cell), self.grid)
+        return grid_lookup(as_points(pts), self.lo, float(self.cell), self.grid)
+
+
+def as_points(p) -> np.ndarray:
+    """``p`` as a C-contiguous (n, 2) float64 array (the kernels' input)."""
+    return np.ascontiguousarray(np.asarray(p, dtype=np.float64).reshape(-1, 2))
+
+
+# The repair's callbacks on a face bounded by straight edges, as data: the
+# repair runs its descent in one numba loop when every callback of a
+# problem is one of these (:func:`sr33.samplers.repair._steps`), else it
+# calls them step by step.  Edges are given as in
+# :mod:`sr33.samplers._line_kernels`: start ``a`` (m, 2), direction ``d``
+# (m, 2), squared length ``dd`` (m,).
+
+
+@dataclass(frozen=True, eq=False)
+class LineProjection:
+    """Each point moved to the nearest point of its nearest edge, its
+    parameter kept within ``[lo, 1 - lo]`` of that edge (``lo`` (m,))."""
+
+    a: np.ndarray
+    d: np.ndarray
+    dd: np.ndarray
+    lo: np.ndarray
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        return line_kernels.project(as_points(p), self.a, self.d, self.dd, self.lo)
+
+
+@dataclass(frozen=True, eq=False)
+class LineClamp:
+    """Points moved ``least`` inside every edge they are less than that
+    inside and less than ``-beyond`` outside of, edge after edge
+    (``normals`` (m, 2) unit, into the face)."""
+
+    a: np.ndarray
+    d: np.ndarray
+    dd: np.ndarray
+    normals: np.ndarray
+    least: float
+    beyond: float
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        return line_kernels.clamp(
+            as_points(p), self.a, self.d, self.dd, self.normals, self.least, self.beyond
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class LineGhosts:
+    """The neighbouring faces unfolded across straight edges: ``corners``,
+    then the points on each edge moved ``h`` and ``2 h`` outwards
+    (``inward`` (m, 2) unit normals into the face)."""
+
+    a: np.ndarray
+    d: np.ndarray
+    dd: np.ndarray
+    inward: np.ndarray
+    h: float
+    corners: np.ndarray
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        return line_kernels.ghosts(
+            as_points(p), self.a, self.d, self.dd, self.inward, self.h, self.corners
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Chain:
+    """The composition of callables, in order (clamps one after another)."""
+
+    parts: tuple
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        for f in self.parts:
+            p = f(p)
+        return p
 
 
 @dataclass(frozen=True)

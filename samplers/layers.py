@@ -35,9 +35,14 @@ from . import _line_kernels as line_kernels
 from .adjacency import EdgeFaces
 from .chart import (
     Arc,
+    Chain,
+    LineClamp,
+    LineGhosts,
+    LineProjection,
     Raster,
     arc_clamp,
     arc_sides,
+    as_points,
     halving_count,
     radial_clamp,
     segment_distance,
@@ -135,11 +140,7 @@ def _project_onto(curves: list, margin: float):
     m = margin / np.sqrt(edges.dd)
 
     if len(both.lines) == len(curves):  # straight edges only: one kernel
-
-        def project_lines(p: np.ndarray) -> np.ndarray:
-            return line_kernels.project(_points(p), edges.a, edges.d, edges.dd, m)
-
-        return project_lines
+        return LineProjection(edges.a, edges.d, edges.dd, m)
 
     def project(p: np.ndarray) -> np.ndarray:
         which = np.argmin(both.distances(p), axis=1)
@@ -230,17 +231,16 @@ def _line_ghosts(lines: list[_Line], h: float):
     )
     edges = _Edges(lines)
     inward = np.array([ln.inward for ln in lines], dtype=np.float64).reshape(-1, 2)
-
-    def ghosts(p: np.ndarray) -> np.ndarray:
-        return line_kernels.ghosts(_points(p), edges.a, edges.d, edges.dd, inward, h, corners)
-
-    return ghosts
+    return LineGhosts(edges.a, edges.d, edges.dd, inward, float(h), corners)
 
 
 def _joined(fns):
-    """One ghost callable giving the points of all of ``fns`` (None: no ghosts)."""
+    """One ghost callable giving the points of all of ``fns`` (None: no
+    ghosts; the one itself when alone)."""
     if not fns:
         return None
+    if len(fns) == 1:
+        return fns[0]
     return lambda p: np.vstack([f(p) for f in fns])
 
 
@@ -301,16 +301,11 @@ class _Edges:
 
     def along(self, p: np.ndarray) -> np.ndarray:
         """(n, m): every point's foot parameter on every edge."""
-        return line_kernels.along(_points(p), self.a, self.d, self.dd)
+        return line_kernels.along(as_points(p), self.a, self.d, self.dd)
 
     def distance(self, p: np.ndarray) -> np.ndarray:
         """(n, m): every point's distance to every edge."""
-        return line_kernels.distance(_points(p), self.a, self.d, self.dd)
-
-
-def _points(p) -> np.ndarray:
-    """``p`` as a C-contiguous (n, 2) float64 array (the kernels' input)."""
-    return np.ascontiguousarray(np.asarray(p, dtype=np.float64).reshape(-1, 2))
+        return line_kernels.distance(as_points(p), self.a, self.d, self.dd)
 
 
 class _Curves:
@@ -484,30 +479,13 @@ def _staggered(uv: np.ndarray, line: _Line, h: float) -> bool:
     return bool(tri.size) and bool((triangle_ratios(pts, tri) >= BAD).any())
 
 
-def _chain(fns):
-    """The composition of the callables (in order)."""
-
-    def run(p: np.ndarray) -> np.ndarray:
-        for f in fns:
-            p = f(p)
-        return p
-
-    return run
-
-
-def _clamp_lines(lines: list[_Line], h: float, margin: float = 0.4):
-    """Keep free samples at least ``margin`` h (by default 0.4) inside every edge of ``lines``."""
-
+def _clamp_lines(lines: list[_Line], h: float, margin: float = 0.4) -> LineClamp:
+    """Keep free samples at least ``margin`` h (by default 0.4) inside every
+    edge of ``lines`` (edge by edge, each seeing the points the ones before
+    it moved)."""
     edges = _Edges(lines)
     normals = np.array([ln.inward for ln in lines], dtype=np.float64).reshape(-1, 2)
-
-    def clamp(p: np.ndarray) -> np.ndarray:
-        # edge by edge, each seeing the points the ones before it moved
-        return line_kernels.clamp(
-            _points(p), edges.a, edges.d, edges.dd, normals, margin * h, -2 * h
-        )
-
-    return clamp
+    return LineClamp(edges.a, edges.d, edges.dd, normals, margin * h, -2 * h)
 
 
 #: positions are compared for congruence on a grid of this many spacings
@@ -726,7 +704,7 @@ def repair_planar_faces(
                     + ([_line_ghosts(follow, h)] if follow else [])
                 ),
                 anchors=anchors if anchors.any() else None,
-                clamp=_chain(clamps),
+                clamp=Chain(tuple(clamps)),
                 frame=frame,
                 judge_frame=True,
                 max_edits=None if arcs else (FOLLOW_EDITS if follow else LINE_EDITS),

@@ -52,6 +52,7 @@ from scipy.spatial import Delaunay, QhullError, cKDTree
 from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
 
+from ._descent_kernels import QHULL, descend_lines
 from ._repair_kernels import (
     canonical_order,
     centroids,
@@ -61,6 +62,7 @@ from ._repair_kernels import (
     gathered_gradient,
     same_points,
 )
+from .chart import Chain, LineClamp, LineGhosts, LineProjection, Raster
 
 TARGET = 0.78  # the descent pushes every ratio below this
 BAD = 0.83  # a triangle above this still needs work (margin below sqrt(3)/2)
@@ -463,7 +465,16 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
         label = cKDTree(np.asarray(centres)).query(prob.uv)[1].astype(np.int64)
     best, since = np.inf, 0
     movable = prob.free | prob.slide  # the roles stay through a descent
-    for _ in range(steps):
+    form = _line_form(prob)
+    done = 0
+    while done < steps:
+        if form is not None:  # the steps that need no Qhull, in one kernel
+            why, ran, best, since = _descend_lines(
+                prob, form, steps - done, subset, active, label, regions, best, since
+            )
+            done += ran
+            if why != QHULL:
+                return
         energy, grad, rho, _, _ = _energy(prob, subset, active)
         if rho.size == 0 or rho.max() < TARGET + 0.02:
             return
@@ -486,6 +497,116 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
             prob.uv[moved] = prob.clamp(prob.uv[moved])
         if prob.turn is not None:
             prob.uv[move] = prob.wrap(prob.uv[move])
+        done += 1
+
+
+def _line_form(prob: _Problem) -> dict | None:
+    """A problem's callbacks as the arrays of
+    :func:`sr33.samplers._descent_kernels.descend_lines`, when every one is
+    a straight-edge form of :mod:`sr33.samplers.chart` (a planar face
+    bounded by straight edges, no development), else None."""
+    parts = prob.clamp.parts if isinstance(prob.clamp, Chain) else (prob.clamp,)
+    parts = tuple(c for c in parts if c is not None)
+    if (
+        prob.turn is not None
+        or not isinstance(prob.inside, Raster)
+        or not (
+            isinstance(prob.project, LineProjection)
+            or (prob.project is None and not prob.slide.any())
+        )
+        or not all(isinstance(c, LineClamp) for c in parts)
+        or not (prob.ghosts is None or isinstance(prob.ghosts, LineGhosts))
+    ):
+        return None
+    none2 = np.empty((0, 2))
+    p = prob.project
+    g = prob.ghosts
+
+    def stacked(name: str, width: int) -> np.ndarray:
+        arrays = [getattr(c, name).reshape(-1, width) for c in parts]
+        return np.ascontiguousarray(np.vstack(arrays) if arrays else np.empty((0, width)))
+
+    return dict(
+        projection=(
+            (p.a, p.d, p.dd, p.lo) if p is not None else (none2, none2, np.empty(0), np.empty(0))
+        ),
+        clamps=(
+            stacked("a", 2),
+            stacked("d", 2),
+            stacked("dd", 1).ravel().copy(),
+            stacked("normals", 2),
+        ),
+        clamp_start=np.cumsum([0] + [c.a.shape[0] for c in parts]).astype(np.int64),
+        clamp_margins=np.array([(c.least, c.beyond) for c in parts], dtype=np.float64).reshape(
+            -1, 2
+        ),
+        ghost_lines=(
+            (g.a, g.d, g.dd, g.inward) if g is not None else (none2, none2, np.empty(0), none2)
+        ),
+        ghost_h=float(g.h) if g is not None else 0.0,
+        corners=g.corners if g is not None else none2,
+        has_ghosts=g is not None,
+        raster=(prob.inside.lo, prob.inside.grid),
+        raster_cell=float(prob.inside.cell),
+    )
+
+
+def _descend_lines(
+    prob: _Problem, form: dict, steps: int, subset, active, label, regions, best, since
+):
+    """:func:`sr33.samplers._descent_kernels.descend_lines` on ``prob``:
+    its samples moved in place and its last triangulation kept; returns
+    why it stopped, the steps made and the descent's best energy and
+    steps since."""
+    h = prob.h
+    watch = prob.watch()
+    last = prob.delaunay
+    idx = np.arange(prob.uv.shape[0]) if subset is None else np.asarray(subset, dtype=np.int64)
+    params = (
+        float(h),
+        0.0 if subset is None else REACH * h,
+        TARGET,
+        SHORT,
+        GAP[0],
+        GAP[1],
+        float(prob.wide),
+        TARGET + 0.02,
+        STEP * h,
+        KEEP_MOVE * h,
+        KEEP_AREA * h * h,
+        KEEP_CIRCLE * h**4,
+    )
+    empty = (np.empty(0, dtype=np.int64), np.empty((0, 2)), np.empty((0, 3), dtype=np.int64))
+    why, ran, best, since, pts, tri, nbr, changed = descend_lines(
+        prob.uv,
+        prob.free,
+        prob.slide,
+        prob.anchor,
+        watch if active is None else active & watch,
+        idx,
+        label,
+        regions,
+        steps,
+        float(best),
+        since,
+        params,
+        (last[0], last[1], last[2], last[3]) if last is not None else (*empty, empty[2]),
+        form["projection"],
+        form["clamps"],
+        form["clamp_start"],
+        form["clamp_margins"],
+        form["ghost_lines"],
+        form["ghost_h"],
+        form["corners"],
+        form["has_ghosts"],
+        prob.frame,
+        prob.frame_id,
+        form["raster"],
+        form["raster_cell"],
+    )
+    if changed:
+        prob.delaunay = (last[0], pts, tri, nbr)
+    return why, ran, best, since
 
 
 def _status(prob: _Problem, subset=None, active=None):

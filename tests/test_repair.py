@@ -458,3 +458,75 @@ def test_a_face_still_stuck_gets_new_shaken_starts_kept_only_when_better_on_both
     calls.clear()
     assert ly.unstuck(uv, free, 0.1, answer(0.84, 3), 0.85, wide=False).worst == 0.84
     assert calls == []
+
+
+def slanted_polygon_problem(h: float = 0.05, turn: float = 0.3):
+    """A hexagon turned off its rows: a square lattice inside it and its
+    edges' samples at equal steps, with the repair's straight-edge
+    callbacks (:mod:`sr33.samplers.chart`)."""
+    from sr33.samplers.chart import Chain, LineClamp, LineGhosts, LineProjection, Raster
+
+    ang = turn + np.arange(6) * np.pi / 3
+    a = 0.5 * np.stack([np.cos(ang), np.sin(ang)], 1)
+    d = np.roll(a, -1, axis=0) - a
+    dd = (d * d).sum(axis=1)
+    inward = np.stack([-d[:, 1], d[:, 0]], 1) / np.sqrt(dd)[:, None]
+    xs = np.arange(-0.5, 0.5 + 1e-9, h)
+    g = np.stack(np.meshgrid(xs, xs), -1).reshape(-1, 2)
+    depth = np.min([(g - a[k]) @ inward[k] for k in range(6)], axis=0)
+    g, depth = g[depth > 0.3 * h], depth[depth > 0.3 * h]
+    m = int(round(np.sqrt(dd[0]) / h))
+    rim = np.vstack([a[k] + np.outer(np.arange(m) / m, d[k]) for k in range(6)])
+    side = np.repeat(np.arange(6), m)
+    uv = np.vstack([g, rim])
+    on_rim = np.r_[np.zeros(len(g), bool), np.ones(len(rim), bool)]
+    at_corner = np.r_[np.zeros(len(g), bool), np.arange(len(rim)) % m == 0]
+    # ghosts beyond three edges, the neighbour's first row (a frame) beyond the others
+    g3 = slice(0, 3)
+    beyond = np.vstack([a[g3] - j * h * inward[g3] for j in (1.0, 2.0)])
+    clamps = (
+        LineClamp(a, d, dd, inward, 0.4 * h, -2 * h),
+        LineClamp(a, d, dd, inward, 0.2 * h, -2 * h),
+    )
+    args = dict(
+        slide=on_rim & ~at_corner,
+        project=LineProjection(a, d, dd, 0.3 * h / np.sqrt(dd)),
+        inside=Raster(np.stack([a, a + d], 1), h / 4),
+        ghosts=LineGhosts(a[g3], d[g3], dd[g3], inward[g3], h, beyond),
+        clamp=Chain(clamps),
+        frame=(rim - h * inward[side])[(side >= 3) & ~at_corner[len(g) :]],
+        judge_frame=True,
+        anchors=at_corner,
+    )
+    free = np.r_[depth < 2.5 * h, np.zeros(len(rim), bool)]
+    return uv, free, h, args
+
+
+@pytest.mark.parametrize("turn", [0.3, 1.1])
+def test_the_descent_in_one_kernel_moves_the_samples_as_the_python_loop(monkeypatch, turn):
+    """A face bounded by straight edges is descended in one numba loop
+    (:mod:`sr33.samplers._descent_kernels`): bit for bit the samples the
+    step-by-step loop gives with the same callbacks as plain functions."""
+    import sr33.samplers.repair as rp
+
+    uv, free, h, args = slanted_polygon_problem(turn=turn)
+    calls = []
+    kernel = rp.descend_lines
+
+    def counted(*a):
+        out = kernel(*a)
+        calls.append(out[1])
+        return out
+
+    monkeypatch.setattr(rp, "descend_lines", counted)
+    fused = repair(uv, free, h, **args)
+    assert sum(calls) > 100  # the kernel made the steps
+    calls.clear()
+    plain = dict(args)
+    for name in ("project", "inside", "ghosts", "clamp"):
+        plain[name] = (lambda f: lambda p: f(p))(args[name])
+    python = repair(uv, free, h, **plain)
+    assert not calls
+    assert fused.uv.tobytes() == python.uv.tobytes()
+    assert fused.origin.tobytes() == python.origin.tobytes()
+    assert (fused.bad, fused.worst) == (python.bad, python.worst)
