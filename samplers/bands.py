@@ -59,6 +59,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
+from sr33 import libm
 from sr33.mesh import dot, norm, triangle_ratios
 
 from .adjacency import EdgeFaces
@@ -113,7 +114,7 @@ class Strip:
         axis from the incoming ruling to each of ``pts``; a point just
         before the incoming ruling has a small negative turn."""
         q = pts - self.o
-        th = np.arctan2(dot(q, self.ey), dot(q, self.ex))
+        th = libm.arctan2(dot(q, self.ey), dot(q, self.ex))
         a = (th - self.theta0) * math.copysign(1.0, self.delta) % (2 * math.pi)
         return np.where(a > 0.5 * (abs(self.delta) + 2 * math.pi), a - 2 * math.pi, a)
 
@@ -168,7 +169,7 @@ class Strip:
         rho0, sin_a, side = self.cone
         v = np.stack([xy[:, 0], rho0 - side * xy[:, 1]], axis=1)  # (rho sin phi, rho cos phi)
         rho = np.linalg.norm(v, axis=1)
-        phi = np.arctan2(v[:, 0], v[:, 1])
+        phi = libm.arctan2(v[:, 0], v[:, 1])
         th = self.theta0 + math.copysign(1.0, self.delta) * phi / sin_a
         axial, radius = self.run_a
         on_a = (
@@ -186,7 +187,7 @@ class Strip:
             rho0, sin_a, side_ = self.cone
             rho = rho0 if side == "a" else float(norm(self.b0 - self.apex))
             v = np.stack([xy[:, 0], rho0 - side_ * xy[:, 1]], axis=1)
-            phi = np.clip(np.arctan2(v[:, 0], v[:, 1]), 0.0, abs(self.delta) * sin_a)
+            phi = np.clip(libm.arctan2(v[:, 0], v[:, 1]), 0.0, abs(self.delta) * sin_a)
             q = np.stack([rho * np.sin(phi), side_ * (rho0 - rho * np.cos(phi))], axis=1)
         else:
             p0, p1 = self.local(
@@ -230,7 +231,7 @@ class Strip:
             rho_b = float(norm(self.b0 - self.apex))
             vx, vy = x, rho0 - side * y
             rho = np.hypot(vx, vy)
-            phi = np.arctan2(vx, vy)
+            phi = libm.arctan2(vx, vy)
             lo, hi = min(rho0, rho_b) - eps, max(rho0, rho_b) + eps
             span = abs(self.delta) * sin_a
             return (rho >= lo) & (rho <= hi) & (phi * rho >= -pad) & ((phi - span) * rho <= pad)

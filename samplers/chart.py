@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from sr33 import libm
 from sr33.mesh import dot
 
 from . import _line_kernels as line_kernels
@@ -150,7 +151,7 @@ class Arc:
 
     def project(self, p: np.ndarray, margin: float) -> np.ndarray:
         d = p - self.centre
-        ang = np.arctan2(d[:, 1], d[:, 0])
+        ang = libm.arctan2(d[:, 1], d[:, 0])
         if not self.closed:
             rel = (ang - self.start) % (2 * math.pi)
             lo, hi = margin / self.radius, self.span - margin / self.radius
@@ -183,7 +184,7 @@ def unfold_across_arc(x, circle, arc: Arc, side: float, to2d, reach: float, scal
     if not near.any():
         return np.empty((0, 2))
     yy, d = to2d(y[near]), d[near]
-    ang = (np.arctan2(*(yy - arc.centre).T[::-1]) - arc.start) % (2 * math.pi)
+    ang = (libm.arctan2(*(yy - arc.centre).T[::-1]) - arc.start) % (2 * math.pi)
     on_arc = arc.closed | (ang <= arc.span)
     yy, d = yy[on_arc], d[on_arc]
     out_dir = side * (yy - arc.centre)
@@ -214,7 +215,7 @@ def arc_clamp(arcs: list[Arc], sides: list[float], h: float):
         for a, side in zip(arcs, sides):
             w = out - a.centre
             r = np.linalg.norm(w, axis=1)
-            ang = (np.arctan2(w[:, 1], w[:, 0]) - a.start) % (2 * math.pi)
+            ang = (libm.arctan2(w[:, 1], w[:, 0]) - a.start) % (2 * math.pi)
             within = a.closed | (ang <= a.span)
             inward = side * (a.radius - r)  # distance into the face from the arc
             margin = (ARC_MARGIN if a.slides else 0.25) * h

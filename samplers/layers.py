@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
+from sr33 import libm
 from sr33.mesh import SQRT3_2, dot, norm, triangle_ratios
 from sr33.progress import log
 
@@ -680,8 +681,8 @@ def repair_planar_faces(
                 if a.wall in walls and cur.size == walls[a.wall].shape[0]:
                     rec = walls[a.wall]
                     rec = to2d(rec - np.outer(dot(rec - o, n), n))
-                    ang_cur = np.arctan2(*(uv[cur] - a.centre).T[::-1])
-                    ang_rec = np.arctan2(*(rec - a.centre).T[::-1])
+                    ang_cur = libm.arctan2(*(uv[cur] - a.centre).T[::-1])
+                    ang_rec = libm.arctan2(*(rec - a.centre).T[::-1])
                     by_cur = np.argsort(ang_cur, kind="stable")
                     uv[cur[by_cur]] = rec[np.argsort(ang_rec, kind="stable")]
                     slide[cur] = False
@@ -924,7 +925,7 @@ def _rim_sources(adjacency, fi: int, face, o, ez, vmin: float, vmax: float, tol:
 def _angles_about(q: np.ndarray, ex: np.ndarray, ey: np.ndarray) -> np.ndarray:
     """The angles of the offsets ``q`` (from a point on an axis) about the
     axis, in the frame ``ex``, ``ey`` across it, ascending in [0, 2 pi)."""
-    return np.sort(np.arctan2(dot(q, ey), dot(q, ex)) % (2 * math.pi))
+    return np.sort(libm.arctan2(dot(q, ey), dot(q, ex)) % (2 * math.pi))
 
 
 def _same_angles(a: np.ndarray, b: np.ndarray) -> bool:
@@ -1108,7 +1109,7 @@ def _developed_worst(rho, ang, rim_ang, slant: float, sin_a: float, t: float, in
     tri = Delaunay(uv).simplices
     c = uv[tri].mean(axis=1)
     rc = np.linalg.norm(c, axis=1)
-    pc = np.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
+    pc = libm.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
     judged = (
         (pc < theta)
         & (rc * np.minimum(pc, theta - pc) > APEX_JUDGED_SIDE * t)
@@ -1529,8 +1530,8 @@ def _fan_figures(radii: np.ndarray, phi):
     side = np.sort(np.stack([a, b, c], axis=2), axis=2)
     ratio = (side[..., 1] / side[..., 2]).max(axis=1)
     # in triangle (apex, k, k + 1): the angle at k + 1 faces spoke k, the one at k faces k + 1
-    at_next = np.arccos(np.clip((b * b + c * c - a * a) / (2 * b * c), -1, 1))
-    at_this = np.arccos(np.clip((a * a + c * c - b * b) / (2 * a * c), -1, 1))
+    at_next = libm.arccos(np.clip((b * b + c * c - a * a) / (2 * b * c), -1, 1))
+    at_this = libm.arccos(np.clip((a * a + c * c - b * b) / (2 * a * c), -1, 1))
     opposite = at_next + np.roll(at_this, 1, axis=1)  # both triangles on spoke k
     return ratio, np.degrees(opposite.max(axis=1)), c.min(axis=1)
 
@@ -1682,7 +1683,7 @@ def _repair_developed(
 
     def inside(c: np.ndarray) -> np.ndarray:
         r = np.linalg.norm(c, axis=1)
-        a = np.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
+        a = libm.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
         return (r < slant) & (r > hole) & (full | (a < theta))
 
     n = uv.shape[0]
@@ -1715,7 +1716,7 @@ def _repair_developed(
     uv2 = out.uv[mine]
     origin = out.origin[mine]
     r2 = np.linalg.norm(uv2, axis=1)
-    a2 = (np.arctan2(uv2[:, 1], uv2[:, 0]) % (2 * math.pi)) / sin_a
+    a2 = (libm.arctan2(uv2[:, 1], uv2[:, 0]) % (2 * math.pi)) / sin_a
     row2 = np.where(origin >= 0, row[np.maximum(origin, 0)], -1)
     return r2, a2, row2, int(out.bad), float(out.worst)
 
@@ -2242,7 +2243,7 @@ def lattice_revolved_body(
                 zone = near <= (reach + POLE_ZONE) * t + 1e-9 * t
                 if face.geomType() == "PLANE":
                     q = made[0][zone] - o
-                    ang = np.arctan2(dot(q, ey), dot(q, ex))
+                    ang = libm.arctan2(dot(q, ey), dot(q, ex))
                     flat = near[zone][:, None] * np.stack([np.cos(ang), np.sin(ang)], axis=1)
                     zones.append(
                         _zone_worst(np.vstack([pole, made[0][zone]]), np.vstack([[0, 0], flat]))
@@ -2255,7 +2256,7 @@ def lattice_revolved_body(
                     # Delaunay triangles (the apex a sample, :func:`_apex_worst`)
                     mine = (made[2] == part[0]) & (near <= (reach + POLE_ZONE + 1) * t)
                     q = made[0][mine] - o
-                    ang = np.arctan2(dot(q, ey), dot(q, ex)) % (2 * math.pi)
+                    ang = libm.arctan2(dot(q, ey), dot(q, ex)) % (2 * math.pi)
                     sin_a = math.sin(abs(basis_surface(face).Cone().SemiAngle()))
                     zones.append(
                         _apex_worst(
@@ -2337,11 +2338,13 @@ class _Cap:
     def to_map(self, sigma) -> np.ndarray:
         """Distance from the pole -> radius on the stereographic map from the
         pole's antipode, isometric at the pole."""
-        return 2.0 * self.radius * np.tan(np.asarray(sigma, dtype=np.float64) / (2.0 * self.radius))
+        return (
+            2.0 * self.radius * libm.tan(np.asarray(sigma, dtype=np.float64) / (2.0 * self.radius))
+        )
 
     def from_map(self, rho) -> np.ndarray:
         return (
-            2.0 * self.radius * np.arctan(np.asarray(rho, dtype=np.float64) / (2.0 * self.radius))
+            2.0 * self.radius * libm.arctan(np.asarray(rho, dtype=np.float64) / (2.0 * self.radius))
         )
 
     def ratios(self, sigma, ang) -> tuple[np.ndarray, np.ndarray]:

@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
+from sr33 import libm
 from sr33.mesh import dot
 
 from .faces import RIM_SAMPLED, Stereographic, basis_surface, goes_round, steps
@@ -97,7 +98,7 @@ class Unrolled:
 
     def __call__(self, p) -> np.ndarray:
         q = np.asarray(p, dtype=np.float64) - self.o
-        ang = (np.arctan2(dot(q, self.ey), dot(q, self.ex)) - self.cut) % (2.0 * math.pi)
+        ang = (libm.arctan2(dot(q, self.ey), dot(q, self.ex)) - self.cut) % (2.0 * math.pi)
         return np.stack([self.radius * ang, dot(q, self.ez)], axis=1)
 
     def inverse(self, c: np.ndarray) -> np.ndarray:
@@ -437,7 +438,7 @@ def _lay_cylinder(fi, face, view: _View, lines, s: Samples, h: float, tol: float
         at = float(dot(np.array(e.Center().toTuple()) - o, ez))
         mine = on & s.on_feature & (np.abs(axial - at) < tol)
         if mine.sum() >= 3:
-            angles = np.sort(np.arctan2(dot(q[mine], ey), dot(q[mine], ex)) % (2 * math.pi))
+            angles = np.sort(libm.arctan2(dot(q[mine], ey), dot(q[mine], ex)) % (2 * math.pi))
             z0 = at
             break
     if angles is None:

@@ -45,6 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay
 
+from sr33 import libm
 from sr33.mesh import dot, norm, triangle_ratios
 
 from .adjacency import EdgeFaces
@@ -121,7 +122,7 @@ def find_pyramid(occ, tol: float) -> Pyramid | None:
     ref = corners[0] - centre
     side = np.cross(normal, ref)
     rel = corners - centre
-    order = np.argsort(np.arctan2(dot(rel, side), dot(rel, ref)) % (2 * math.pi), kind="stable")
+    order = np.argsort(libm.arctan2(dot(rel, side), dot(rel, ref)) % (2 * math.pi), kind="stable")
     corners = corners[order]
     sides = np.linalg.norm(np.roll(corners, -1, axis=0) - corners, axis=1)
     diagonals = np.linalg.norm(corners[:2] - corners[2:], axis=1)

@@ -49,6 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
+from sr33 import libm
 from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
 
@@ -147,7 +148,7 @@ def glued(p: np.ndarray, turn: float | None) -> np.ndarray:
     cone's intrinsic ones."""
     if turn is None:
         return p
-    a = np.arctan2(p[:, 1], p[:, 0]) % (2 * np.pi)
+    a = libm.arctan2(p[:, 1], p[:, 0]) % (2 * np.pi)
     half = glue_reach(turn)
     return np.vstack([p, rotate(p[a < half], turn), rotate(p[turn - a < half], -turn)])
 
@@ -245,7 +246,7 @@ class _Problem:
             return np.empty((0, 2)), np.empty(0, dtype=np.int64), np.empty(0)
         p = self.uv[idx]
         r = np.linalg.norm(p, axis=1)
-        a = np.arctan2(p[:, 1], p[:, 0]) % (2 * np.pi)
+        a = libm.arctan2(p[:, 1], p[:, 0]) % (2 * np.pi)
         band = IMAGE_BAND * self.h
         out, of, angle = [], [], []
         # within half the wedge outside the sector too, so that the images
@@ -263,7 +264,7 @@ class _Problem:
         """Positions turned back into the development's sector [0, turn)."""
         if self.turn is None or p.shape[0] == 0:
             return p
-        a = np.arctan2(p[:, 1], p[:, 0]) % (2 * np.pi)
+        a = libm.arctan2(p[:, 1], p[:, 0]) % (2 * np.pi)
         k = np.where(a >= self.turn, np.where(a >= 0.5 * (self.turn + 2 * np.pi), 1.0, -1.0), 0.0)
         return rotate(p, k * self.turn)
 

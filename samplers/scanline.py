@@ -71,6 +71,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
+from sr33 import libm
 from sr33.mesh import dot, norm, surface_points
 from sr33.progress import bar, log, timed
 
@@ -641,7 +642,7 @@ def _plane_offsets(lo: float, hi: float, t0: float, hf: float, sphere=None) -> n
         return t0 + np.arange(j0, j1 + 1) * hf
     centre, radius, _, _, d = sphere
     c = float(dot(centre, d))
-    psi = np.arccos(np.clip((c - np.array([lo, hi])) / radius, -1.0, 1.0))  # grows with t
+    psi = libm.arccos(np.clip((c - np.array([lo, hi])) / radius, -1.0, 1.0))  # grows with t
     step = hf / radius
     k = np.arange(math.ceil(psi[0] / step - 1e-9), math.floor(psi[1] / step + 1e-9) + 1)
     return c - radius * np.cos(k * step)

@@ -28,6 +28,8 @@ from scipy import sparse
 from scipy.sparse import csgraph
 from scipy.spatial import ConvexHull, QhullError
 
+from sr33 import libm
+
 from . import _edges, _intersect
 
 SQRT3_2 = float(np.sqrt(3.0) / 2.0)  # Condition III-ii: shorter edges below this times the longest
@@ -476,7 +478,7 @@ def near_cocircular(points, triangles, slack: float) -> np.ndarray:
     def angle(at, u, v):
         x, y = p[u] - p[at], p[v] - p[at]
         cos = (x * y).sum(axis=1) / np.maximum(norm(x) * norm(y), 1e-300)
-        return np.arccos(np.clip(cos, -1.0, 1.0))
+        return libm.arccos(np.clip(cos, -1.0, 1.0))
 
     near = angle(c, a, b) + angle(d, a, b) > np.pi - slack
     return np.stack([a, b, c, d], axis=1)[near].astype(np.int64)

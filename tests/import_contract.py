@@ -47,6 +47,7 @@ BASE = {
     "sr33._intersect",
     "sr33._edges",
     "sr33.jit",
+    "sr33.libm",
 }
 TOP = {"sr33", "sr33.cli"}  # the hub and the command line see everything
 

@@ -23,6 +23,7 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
+from sr33 import libm
 from sr33.mesh import SQRT3_2, as_mesh, edge_incidence, half_edges, triangle_ratios, unique_rows
 from sr33.neighbours import tied_neighbours
 
@@ -660,7 +661,7 @@ def _quads(tri: np.ndarray, edges: np.ndarray, n: int) -> np.ndarray:
 
 def _angle(x, y, z) -> np.ndarray:
     """Angle opposite the side z of the flat triangle with sides x, y, z."""
-    return np.arccos(np.clip((x * x + y * y - z * z) / (2.0 * x * y), -1.0, 1.0))
+    return libm.arccos(np.clip((x * x + y * y - z * z) / (2.0 * x * y), -1.0, 1.0))
 
 
 def _cell_curvature(tv, tf, label, snap, n: int) -> np.ndarray:
