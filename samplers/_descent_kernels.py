@@ -1,14 +1,13 @@
-"""numba kernel of the repair's descent on a face bounded by straight edges
+"""numba kernel of the repair's descent on a planar face (straight edges, arcs)
 (:func:`sr33.samplers.repair._steps`): the steps of one descent in one loop.
 
 A descent step on a few hundred samples is a dozen small kernels and twice
 as many numpy calls; in Python the calls cost several times the arithmetic
 (a hexagonal prism's caps: 0.27 ms a step, 0.05 ms of it in kernels).
-Where every callback of a repair problem is one of the straight-edge forms
-of :mod:`sr33.samplers.chart` (:class:`~sr33.samplers.chart.LineProjection`,
-:class:`~sr33.samplers.chart.LineClamp`,
-:class:`~sr33.samplers.chart.LineGhosts`, an inside test by
-:class:`~sr33.samplers.chart.Raster`), :func:`descend_lines` runs the steps
+Where every callback of a repair problem is one of the planar forms of
+:mod:`sr33.samplers.chart` (the projections onto straight edges and arcs,
+their clamps and ghosts, an inside test by
+:class:`~sr33.samplers.chart.Raster`), :func:`descend` runs the steps
 here, calling the same kernels on the same arrays in the same order as the
 Python loop: bit for bit its samples.  It hands back to Python when a step
 needs Qhull (the points changed or an edge flip cannot mend the last
@@ -21,7 +20,7 @@ import numpy as np
 
 from sr33.jit import njit
 
-from ._line_kernels import clamp, ghosts, project
+from ._line_kernels import clamp, clamp_arcs, ghosts, ghosts_arcs, project_curves
 from ._repair_kernels import (
     canonical_order,
     centroids,
@@ -33,17 +32,41 @@ from ._repair_kernels import (
     same_points,
 )
 
-FINISHED, QHULL, OUT_OF_STEPS = 0, 1, 2  # why :func:`descend_lines` returned
+FINISHED, QHULL, OUT_OF_STEPS = 0, 1, 2  # why :func:`descend` returned
 GHOST, FRAME = -1, -2  # the sample id of a ghost point and of a judged frame point
 
 
 @njit(cache=True)
-def _extended(uv, idx, slide, ghost_lines, ghost_h, corners, has_ghosts, frame, frame_id, h):
+def _ghost_points(on, ghost_arcs, ghost_lines, ghost_h, kinds):
+    """The ghosts of the sliding samples ``on``: of each of ``kinds`` in
+    order (0: across straight edges, :func:`ghosts`; 1: across arcs,
+    :func:`ghosts_arcs`)."""
+    parts = []
+    for kind in kinds:
+        if kind == 0:
+            ga, gd, gdd, gin, corners = ghost_lines
+            parts.append(ghosts(on, ga, gd, gdd, gin, ghost_h, corners))
+        else:
+            centre, radius, side = ghost_arcs
+            parts.append(ghosts_arcs(on, centre, radius, side, ghost_h))
+    total = 0
+    for g in parts:
+        total += g.shape[0]
+    out = np.empty((total, 2))
+    row = 0
+    for g in parts:
+        out[row : row + g.shape[0]] = g
+        row += g.shape[0]
+    return out
+
+
+@njit(cache=True)
+def _extended(uv, idx, slide, ghost_arcs, ghost_lines, ghost_h, ghost_kinds, frame, frame_id, h):
     """The samples ``idx``, the ghosts of their sliding ones and the frame's
     points within 3 h of their bounding box, with the id of each
     (``repair._Problem.extended`` without a development's images)."""
     n = idx.size
-    if has_ghosts:
+    if ghost_kinds.size:
         count = 0
         for i in range(n):
             if slide[idx[i]]:
@@ -55,8 +78,7 @@ def _extended(uv, idx, slide, ghost_lines, ghost_h, corners, has_ghosts, frame, 
                 on[count, 0] = uv[idx[i], 0]
                 on[count, 1] = uv[idx[i], 1]
                 count += 1
-        ga, gd, gdd, gin = ghost_lines
-        g = ghosts(on, ga, gd, gdd, gin, ghost_h, corners)
+        g = _ghost_points(on, ghost_arcs, ghost_lines, ghost_h, ghost_kinds)
     else:
         g = np.empty((0, 2))
     kept = np.zeros(frame.shape[0], dtype=np.bool_)
@@ -120,7 +142,41 @@ def _scatter(uv, mask, values):
 
 
 @njit(cache=True)
-def descend_lines(
+def _clamped(q, parts, line_clamps, line_margins, arc_clamps):
+    """``q`` through every clamp of ``parts`` in order (rows: kind, first,
+    end; kind 0 the straight edges ``line_clamps`` [first, end) with that
+    part's (least, beyond) in ``line_margins``, kind 1 the arcs
+    ``arc_clamps`` [first, end))."""
+    ca, cd, cdd, cn = line_clamps
+    centre, radius, start, span, closed, side, margin = arc_clamps
+    for k in range(parts.shape[0]):
+        s, e = parts[k, 1], parts[k, 2]
+        if parts[k, 0] == 0:
+            q = clamp(
+                q,
+                ca[s:e].copy(),
+                cd[s:e].copy(),
+                cdd[s:e].copy(),
+                cn[s:e].copy(),
+                line_margins[k, 0],
+                line_margins[k, 1],
+            )
+        else:
+            q = clamp_arcs(
+                q,
+                centre[s:e].copy(),
+                radius[s:e].copy(),
+                start[s:e].copy(),
+                span[s:e].copy(),
+                closed[s:e].copy(),
+                side[s:e].copy(),
+                margin[s:e].copy(),
+            )
+    return q
+
+
+@njit(cache=True)
+def descend(
     uv,
     free,
     slide,
@@ -135,30 +191,32 @@ def descend_lines(
     params,
     last,
     projection,
-    clamps,
-    clamp_start,
-    clamp_margins,
+    has_projection,
+    clamp_parts,
+    line_clamps,
+    line_margins,
+    arc_clamps,
+    ghost_arcs,
     ghost_lines,
     ghost_h,
-    corners,
-    has_ghosts,
+    ghost_kinds,
     frame,
     frame_id,
     raster,
     raster_cell,
 ):
     """Up to ``steps`` steps of the repair's descent (``repair._steps``), in
-    place on ``uv``, for a face bounded by straight edges.
+    place on ``uv``, for a planar face bounded by straight edges and arcs.
 
     ``params`` = (h, reach, target, short, gap_lo, gap_hi, wide, stop
     ratio, step length, keep move, keep area, keep circle), as the repair
     computes them; ``last`` = (ids, points, triangles, neighbours) of the
-    last triangulation (empty ids: none); ``projection`` = (a, d, dd, lo)
-    of :class:`~sr33.samplers.chart.LineProjection`; ``clamps`` = (a, d,
-    dd, normals) of every :class:`~sr33.samplers.chart.LineClamp` stacked,
-    the k-th's rows from ``clamp_start[k]``, its (least, beyond) in
-    ``clamp_margins[k]``; the ghosts' (a, d, dd, inward), h and corners;
-    ``raster`` = (lo, grid) with its cell.
+    last triangulation (empty ids: none); ``projection`` the table of a
+    :class:`~sr33.samplers.chart.CurveProjection` (kind, a, d, dd, lo,
+    centre, radius, start, span, closed, margin); the clamps as
+    :func:`_clamped` takes them; the ghosts' arcs (centre, radius, side),
+    straight edges (a, d, dd, inward, corners), h and kinds in order (see
+    :func:`_ghost_points`); ``raster`` = (lo, grid) with its cell.
 
     Returns why it stopped (``FINISHED``: the descent is over; ``QHULL``:
     the next step needs Qhull; ``OUT_OF_STEPS``), the steps made, the
@@ -180,8 +238,7 @@ def descend_lines(
         keep_circle,
     ) = params
     last_of, last_pts, last_tri, last_nbr = last
-    pa, pd, pdd, plo = projection
-    ca, cd, cdd, cn = clamps
+    kind, pa, pd, pdd, plo, centre, radius, start, span, closed, margin = projection
     lo, grid = raster
     n = uv.shape[0]
     move = free | slide
@@ -190,7 +247,7 @@ def descend_lines(
     done = 0
     while done < steps:
         pts, of = _extended(
-            uv, idx, slide, ghost_lines, ghost_h, corners, has_ghosts, frame, frame_id, h
+            uv, idx, slide, ghost_arcs, ghost_lines, ghost_h, ghost_kinds, frame, frame_id, h
         )
         if pts.shape[0] < 3:
             return FINISHED, done, best, since, last_pts, last_tri, last_nbr, changed
@@ -237,22 +294,28 @@ def descend_lines(
         if not moved.any():
             return FINISHED, done, best, since, last_pts, last_tri, last_nbr, changed
         slid = moved & slide
-        if slid.any():
-            _scatter(uv, slid, project(_gather(uv, slid), pa, pd, pdd, plo))
+        if has_projection and slid.any():
+            on = project_curves(
+                _gather(uv, slid),
+                kind,
+                pa,
+                pd,
+                pdd,
+                plo,
+                centre,
+                radius,
+                start,
+                span,
+                closed,
+                margin,
+            )
+            _scatter(uv, slid, on)
         shifted = moved & free
-        if clamp_start.size > 1 and shifted.any():
-            q = _gather(uv, shifted)
-            for k in range(clamp_start.size - 1):
-                s, e = clamp_start[k], clamp_start[k + 1]
-                q = clamp(
-                    q,
-                    ca[s:e].copy(),
-                    cd[s:e].copy(),
-                    cdd[s:e].copy(),
-                    cn[s:e].copy(),
-                    clamp_margins[k, 0],
-                    clamp_margins[k, 1],
-                )
-            _scatter(uv, shifted, q)
+        if clamp_parts.shape[0] and shifted.any():
+            _scatter(
+                uv,
+                shifted,
+                _clamped(_gather(uv, shifted), clamp_parts, line_clamps, line_margins, arc_clamps),
+            )
         done += 1
     return OUT_OF_STEPS, done, best, since, last_pts, last_tri, last_nbr, changed

@@ -115,3 +115,122 @@ def project(p, a, d, dd, lo):
         out[i, 0] = a[k, 0] + t * d[k, 0]
         out[i, 1] = a[k, 1] + t * d[k, 1]
     return out
+
+
+TWO_PI = 2 * np.pi
+
+
+@njit(cache=True)
+def _arc_distance(x, y, cx, cy, r):
+    dx = x - cx
+    dy = y - cy
+    return abs(np.sqrt(dx * dx + dy * dy) - r)
+
+
+@njit(cache=True)
+def project_curves(p, kind, a, d, dd, lo, centre, radius, start, span, closed, margin):
+    """Each point moved to the nearest point of its nearest curve (the
+    first of equally near ones): a straight edge (``kind`` 0, see
+    :func:`project`) or an arc (``kind`` 1: of ``radius`` about ``centre``,
+    from angle ``start`` over ``span``, or all round where ``closed``),
+    kept ``margin`` from an open arc's ends (a point past either end goes to
+    the nearer end).  Bit for bit ``layers._project_onto``'s numpy code."""
+    m = kind.shape[0]
+    dist = np.empty(m)
+    out = p.copy()
+    for i in range(p.shape[0]):
+        x, y = p[i, 0], p[i, 1]
+        for k in range(m):
+            if kind[k] == 0:
+                t = ((x - a[k, 0]) * d[k, 0] + (y - a[k, 1]) * d[k, 1]) / dd[k]
+                t = min(max(t, 0.0), 1.0)
+                qx = x - (a[k, 0] + t * d[k, 0])
+                qy = y - (a[k, 1] + t * d[k, 1])
+                dist[k] = np.sqrt(qx * qx + qy * qy)
+            else:
+                dist[k] = _arc_distance(x, y, centre[k, 0], centre[k, 1], radius[k])
+        k = 0
+        for q in range(1, m):
+            if dist[q] < dist[k]:
+                k = q
+        if kind[k] == 0:
+            t = ((x - a[k, 0]) * d[k, 0] + (y - a[k, 1]) * d[k, 1]) / dd[k]
+            t = min(max(t, lo[k]), 1.0 - lo[k])
+            out[i, 0] = a[k, 0] + t * d[k, 0]
+            out[i, 1] = a[k, 1] + t * d[k, 1]
+        else:
+            ang = np.arctan2(y - centre[k, 1], x - centre[k, 0])
+            if not closed[k]:
+                rel = (ang - start[k]) % TWO_PI
+                low = margin / radius[k]
+                high = span[k] - margin / radius[k]
+                if rel > span[k] + (TWO_PI - span[k]) / 2:
+                    rel = low
+                else:
+                    rel = min(max(rel, low), high)
+                ang = start[k] + rel
+            out[i, 0] = centre[k, 0] + radius[k] * np.cos(ang)
+            out[i, 1] = centre[k, 1] + radius[k] * np.sin(ang)
+    return out
+
+
+@njit(cache=True)
+def clamp_arcs(p, centre, radius, start, span, closed, side, margin):
+    """Points moved onto the face's side of every arc (see
+    :func:`project_curves`; ``side`` +1 where the face lies inside its
+    circle), at least ``margin`` from it where they fall within its span
+    and are nearer: arc after arc, each seeing the points the ones before
+    it moved.  Returns a new array (``chart.ArcClamp``)."""
+    out = p.copy()
+    for k in range(centre.shape[0]):
+        target = radius[k] - side[k] * margin[k]
+        for i in range(out.shape[0]):
+            wx = out[i, 0] - centre[k, 0]
+            wy = out[i, 1] - centre[k, 1]
+            r = np.sqrt(wx * wx + wy * wy)
+            ang = (np.arctan2(wy, wx) - start[k]) % TWO_PI
+            within = closed[k] or ang <= span[k]
+            inward = side[k] * (radius[k] - r)
+            if within and inward < margin[k] and r > 1e-12:
+                out[i, 0] = centre[k, 0] + wx / r * target
+                out[i, 1] = centre[k, 1] + wy / r * target
+    return out
+
+
+@njit(cache=True)
+def ghosts_arcs(p, centre, radius, side, h):
+    """The faces across arcs unfolded (``chart.ArcGhosts``): arc by arc,
+    the points of ``p`` on it (within 1e-6 h of their nearest arc, the
+    first of equally near ones) moved h and then 2h across it, straight out
+    from its centre (``side`` +1 where the face lies inside the circle)."""
+    n, m = p.shape[0], centre.shape[0]
+    which = np.full(n, -1, dtype=np.int64)
+    for i in range(n):
+        best = np.inf
+        k = -1
+        for q in range(m):
+            dq = _arc_distance(p[i, 0], p[i, 1], centre[q, 0], centre[q, 1], radius[q])
+            if k < 0 or dq < best:
+                best, k = dq, q
+        if k >= 0 and best < 1e-6 * h:
+            which[i] = k
+    count = 0
+    for i in range(n):
+        if which[i] >= 0:
+            count += 1
+    out = np.empty((2 * count, 2))
+    row = 0
+    for k in range(m):
+        for j in (1.0, 2.0):
+            reach = radius[k] + side[k] * j * h
+            for i in range(n):
+                if which[i] == k:
+                    wx = p[i, 0] - centre[k, 0]
+                    wy = p[i, 1] - centre[k, 1]
+                    length = np.sqrt(wx * wx + wy * wy)
+                    wx = wx / length
+                    wy = wy / length
+                    out[row, 0] = centre[k, 0] + reach * wx
+                    out[row, 1] = centre[k, 1] + reach * wy
+                    row += 1
+    return out

@@ -149,18 +149,6 @@ class Arc:
     def distance(self, p: np.ndarray) -> np.ndarray:
         return np.abs(np.linalg.norm(p - self.centre, axis=1) - self.radius)
 
-    def project(self, p: np.ndarray, margin: float) -> np.ndarray:
-        d = p - self.centre
-        ang = libm.arctan2(d[:, 1], d[:, 0])
-        if not self.closed:
-            rel = (ang - self.start) % (2 * math.pi)
-            lo, hi = margin / self.radius, self.span - margin / self.radius
-            # a point past either end goes to the nearer end
-            past = rel > self.span + (2 * math.pi - self.span) / 2
-            rel = np.where(past, lo, np.clip(rel, lo, hi))
-            ang = self.start + rel
-        return self.centre + self.radius * np.stack([np.cos(ang), np.sin(ang)], axis=1)
-
 
 def unfold_across_arc(x, circle, arc: Arc, side: float, to2d, reach: float, scale=None, clear=None):
     """Points of the face across a circular sharp edge unfolded into a
@@ -204,28 +192,161 @@ def arc_sides(arcs: list[Arc], raster: Raster, h: float) -> list[float]:
     return sides
 
 
-def arc_clamp(arcs: list[Arc], sides: list[float], h: float):
+def arc_clamp(arcs: list[Arc], sides: list[float], h: float) -> ArcClamp:
     """Keep free samples on the face side of every arc, at least ``ARC_MARGIN`` h
     from a full cylinder's rim (nearer, a sample makes a Delaunay triangle with
     the wall's first row across the rim, which the repair does not judge) and
     h / 4 from other arcs."""
+    return ArcClamp(
+        *_arc_arrays(arcs),
+        np.array(sides, dtype=np.float64).reshape(-1),
+        np.array([(ARC_MARGIN if a.slides else 0.25) * h for a in arcs], dtype=np.float64),
+    )
 
-    def clamp(p: np.ndarray) -> np.ndarray:
-        out = p.copy()
-        for a, side in zip(arcs, sides):
-            w = out - a.centre
-            r = np.linalg.norm(w, axis=1)
-            ang = (libm.arctan2(w[:, 1], w[:, 0]) - a.start) % (2 * math.pi)
-            within = a.closed | (ang <= a.span)
-            inward = side * (a.radius - r)  # distance into the face from the arc
-            margin = (ARC_MARGIN if a.slides else 0.25) * h
-            bad = within & (inward < margin) & (r > 1e-12)
-            if bad.any():
-                target = a.radius - side * margin
-                out[bad] = a.centre + w[bad] / r[bad, None] * target
-        return out
 
-    return clamp
+def _arc_arrays(arcs: list[Arc]):
+    """(centres, radii, starts, spans, closed) of ``arcs`` as arrays."""
+    return (
+        np.array([a.centre for a in arcs], dtype=np.float64).reshape(-1, 2),
+        np.array([a.radius for a in arcs], dtype=np.float64).reshape(-1),
+        np.array([a.start for a in arcs], dtype=np.float64).reshape(-1),
+        np.array([a.span for a in arcs], dtype=np.float64).reshape(-1),
+        np.array([a.closed for a in arcs], dtype=np.bool_).reshape(-1),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class ArcClamp:
+    """Points moved onto the face's side of every arc (``side`` +1 where the
+    face lies inside its circle), ``margin`` (per arc) from it where they
+    fall within its span and are nearer, arc after arc."""
+
+    centre: np.ndarray
+    radius: np.ndarray
+    start: np.ndarray
+    span: np.ndarray
+    closed: np.ndarray
+    side: np.ndarray
+    margin: np.ndarray
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        return line_kernels.clamp_arcs(
+            as_points(p),
+            self.centre,
+            self.radius,
+            self.start,
+            self.span,
+            self.closed,
+            self.side,
+            self.margin,
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class ArcGhosts:
+    """The faces across arcs unfolded: the points on an arc moved ``h``
+    and ``2 h`` across it, straight out from its centre (``side`` +1 where
+    the face lies inside its circle)."""
+
+    centre: np.ndarray
+    radius: np.ndarray
+    side: np.ndarray
+    h: float
+
+    @classmethod
+    def of(cls, arcs: list[Arc], sides: list[float], h: float) -> ArcGhosts:
+        centre, radius, _, _, _ = _arc_arrays(arcs)
+        return cls(centre, radius, np.array(sides, dtype=np.float64).reshape(-1), float(h))
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        return line_kernels.ghosts_arcs(as_points(p), self.centre, self.radius, self.side, self.h)
+
+
+@dataclass(frozen=True, eq=False)
+class CurveProjection:
+    """Each point moved to the nearest point of its nearest curve, arcs and
+    straight edges in one table (``kind`` 0 a straight edge: ``a``, ``d``,
+    ``dd``, its parameter kept within ``[lo, 1 - lo]``; 1 an arc: its
+    ``centre``, ``radius``, ``start``, ``span``, ``closed``, kept ``margin``
+    from an open arc's ends); the first of equally near curves."""
+
+    kind: np.ndarray
+    a: np.ndarray
+    d: np.ndarray
+    dd: np.ndarray
+    lo: np.ndarray
+    centre: np.ndarray
+    radius: np.ndarray
+    start: np.ndarray
+    span: np.ndarray
+    closed: np.ndarray
+    margin: float
+
+    @classmethod
+    def of_lines(cls, lines: LineProjection) -> CurveProjection:
+        """The straight edges of a :class:`LineProjection` as a table."""
+        m = lines.a.shape[0]
+        zeros = np.zeros(m)
+        return cls(
+            np.zeros(m, dtype=np.int64),
+            lines.a,
+            lines.d,
+            lines.dd,
+            lines.lo,
+            np.zeros((m, 2)),
+            zeros,
+            zeros,
+            zeros,
+            np.zeros(m, dtype=np.bool_),
+            0.0,
+        )
+
+    @classmethod
+    def of_curves(cls, curves: list, lines, margin: float) -> CurveProjection:
+        """``curves`` in order, each an :class:`Arc` or a straight edge
+        (``lines``, in the order the straight ones come, as (a, d, dd, lo))."""
+        m = len(curves)
+        kind = np.array([0 if not isinstance(c, Arc) else 1 for c in curves], dtype=np.int64)
+        a, d, dd, lo = np.zeros((m, 2)), np.zeros((m, 2)), np.ones(m), np.zeros(m)
+        straight = np.flatnonzero(kind == 0)
+        a[straight], d[straight], dd[straight], lo[straight] = lines
+        centre, radius, start, span, closed = (
+            np.zeros((m, 2)),
+            np.zeros(m),
+            np.zeros(m),
+            np.zeros(m),
+            np.zeros(m, dtype=np.bool_),
+        )
+        round_ = np.flatnonzero(kind == 1)
+        arrays = _arc_arrays([curves[k] for k in round_])
+        centre[round_], radius[round_], start[round_], span[round_], closed[round_] = arrays
+        return cls(kind, a, d, dd, lo, centre, radius, start, span, closed, float(margin))
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        return line_kernels.project_curves(
+            as_points(p),
+            self.kind,
+            self.a,
+            self.d,
+            self.dd,
+            self.lo,
+            self.centre,
+            self.radius,
+            self.start,
+            self.span,
+            self.closed,
+            self.margin,
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Joined:
+    """The points of several ghost callables, one after another."""
+
+    parts: tuple
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        return np.vstack([f(p) for f in self.parts])
 
 
 def radial_clamp(lo: float, hi: float):

@@ -36,7 +36,10 @@ from . import _line_kernels as line_kernels
 from .adjacency import EdgeFaces
 from .chart import (
     Arc,
+    ArcGhosts,
     Chain,
+    CurveProjection,
+    Joined,
     LineClamp,
     LineGhosts,
     LineProjection,
@@ -132,40 +135,16 @@ def _arcs(face, to2d, across=()) -> list[Arc]:
 def _project_onto(curves: list, margin: float):
     """Map each point to the nearest point of its nearest curve (arcs and
     lines), at least ``margin`` from the curve's ends."""
-
     both = _Curves(curves)
     edges = both.edges
-    column = np.full(len(curves), -1)
-    column[both.lines] = np.arange(len(both.lines))
     # a line's ends are kept ``margin`` away: its parameter within [m, 1 - m]
     m = margin / np.sqrt(edges.dd)
-
     if len(both.lines) == len(curves):  # straight edges only: one kernel
         return LineProjection(edges.a, edges.d, edges.dd, m)
-
-    def project(p: np.ndarray) -> np.ndarray:
-        which = np.argmin(both.distances(p), axis=1)
-        out = p.copy()
-        # the lines at once (the same operations as _Line.project, point by point)
-        on = column[which]
-        sel = np.flatnonzero(on >= 0)
-        if sel.size:
-            k = on[sel]
-            t = dot(p[sel] - edges.a[k], edges.d[k]) / edges.dd[k]
-            t = np.clip(t, m[k], 1.0 - m[k])
-            out[sel] = edges.a[k] + t[:, None] * edges.d[k]
-        for k, a in enumerate(curves):
-            if column[k] >= 0:
-                continue
-            sel = which == k
-            if sel.any():
-                out[sel] = a.project(p[sel], margin)
-        return out
-
-    return project
+    return CurveProjection.of_curves(curves, (edges.a, edges.d, edges.dd, m), margin)
 
 
-def _ghosts(arcs: list[Arc], sides: list[float], h: float):
+def _ghosts(arcs: list[Arc], sides: list[float], h: float) -> ArcGhosts:
     """The neighbouring face unfolded across the arcs: rows h and 2h beyond each arc sample.
 
     The cylinder (or cone, or sphere) on the other side of a circular edge
@@ -173,27 +152,7 @@ def _ghosts(arcs: list[Arc], sides: list[float], h: float):
     the edge; unfolded into the plane those rows stand beyond the arc
     (``sides``: +1 where the face is inside the arc's circle, so outwards).
     """
-
-    curves = _Curves(arcs)
-
-    def ghosts(p: np.ndarray) -> np.ndarray:
-        # the sliding samples on an arc (those on a straight edge have the frame)
-        d = curves.distances(p)
-        on = d.min(axis=1) < 1e-6 * h
-        if not on.any():
-            return np.empty((0, 2))
-        p = p[on]
-        which = np.argmin(d[on], axis=1)
-        out = []
-        for k, a in enumerate(arcs):
-            q = p[which == k]
-            w = q - a.centre
-            w /= np.linalg.norm(w, axis=1)[:, None]
-            for j in (1.0, 2.0):
-                out.append(a.centre + (a.radius + sides[k] * j * h) * w)
-        return np.vstack(out)
-
-    return ghosts
+    return ArcGhosts.of(arcs, sides, h)
 
 
 def _band_arcs(nbrs, to2d, arcs: list[Arc], sides, s: Samples, h: float, unfold):
@@ -242,7 +201,7 @@ def _joined(fns):
         return None
     if len(fns) == 1:
         return fns[0]
-    return lambda p: np.vstack([f(p) for f in fns])
+    return Joined(tuple(fns))
 
 
 def _plane_frame(face):

@@ -53,7 +53,7 @@ from sr33 import libm
 from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
 
-from ._descent_kernels import QHULL, descend_lines
+from ._descent_kernels import QHULL, descend
 from ._repair_kernels import (
     canonical_order,
     centroids,
@@ -63,7 +63,17 @@ from ._repair_kernels import (
     gathered_gradient,
     same_points,
 )
-from .chart import Chain, LineClamp, LineGhosts, LineProjection, Raster
+from .chart import (
+    ArcClamp,
+    ArcGhosts,
+    Chain,
+    CurveProjection,
+    Joined,
+    LineClamp,
+    LineGhosts,
+    LineProjection,
+    Raster,
+)
 
 TARGET = 0.78  # the descent pushes every ratio below this
 BAD = 0.83  # a triangle above this still needs work (margin below sqrt(3)/2)
@@ -466,11 +476,11 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
         label = cKDTree(np.asarray(centres)).query(prob.uv)[1].astype(np.int64)
     best, since = np.inf, 0
     movable = prob.free | prob.slide  # the roles stay through a descent
-    form = _line_form(prob)
+    form = _kernel_form(prob)
     done = 0
     while done < steps:
         if form is not None:  # the steps that need no Qhull, in one kernel
-            why, ran, best, since = _descend_lines(
+            why, ran, best, since = _descend_fused(
                 prob, form, steps - done, subset, active, label, regions, best, since
             )
             done += ran
@@ -501,64 +511,109 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
         done += 1
 
 
-def _line_form(prob: _Problem) -> dict | None:
+def _kernel_form(prob: _Problem) -> dict | None:
     """A problem's callbacks as the arrays of
-    :func:`sr33.samplers._descent_kernels.descend_lines`, when every one is
-    a straight-edge form of :mod:`sr33.samplers.chart` (a planar face
-    bounded by straight edges, no development), else None."""
+    :func:`sr33.samplers._descent_kernels.descend`, when every one is a
+    planar form of :mod:`sr33.samplers.chart` (a planar face bounded by
+    straight edges and arcs, no development), else None."""
     parts = prob.clamp.parts if isinstance(prob.clamp, Chain) else (prob.clamp,)
     parts = tuple(c for c in parts if c is not None)
+    ghosts = prob.ghosts.parts if isinstance(prob.ghosts, Joined) else (prob.ghosts,)
+    ghosts = tuple(g for g in ghosts if g is not None)
+    p = prob.project
+    if isinstance(p, LineProjection):
+        p = CurveProjection.of_lines(p)
     if (
         prob.turn is not None
         or not isinstance(prob.inside, Raster)
-        or not (
-            isinstance(prob.project, LineProjection)
-            or (prob.project is None and not prob.slide.any())
-        )
-        or not all(isinstance(c, LineClamp) for c in parts)
-        or not (prob.ghosts is None or isinstance(prob.ghosts, LineGhosts))
+        or not (isinstance(p, CurveProjection) or (p is None and not prob.slide.any()))
+        or not all(isinstance(c, (LineClamp, ArcClamp)) for c in parts)
+        or not all(isinstance(g, (LineGhosts, ArcGhosts)) for g in ghosts)
+        or sum(isinstance(g, LineGhosts) for g in ghosts) > 1
+        or sum(isinstance(g, ArcGhosts) for g in ghosts) > 1
+        or len({g.h for g in ghosts}) > 1
     ):
         return None
     none2 = np.empty((0, 2))
-    p = prob.project
-    g = prob.ghosts
+    none = np.empty(0)
+    lines = [c for c in parts if isinstance(c, LineClamp)]
+    arcs = [c for c in parts if isinstance(c, ArcClamp)]
+    rows, at = [], {LineClamp: 0, ArcClamp: 0}
+    for c in parts:
+        count = c.a.shape[0] if isinstance(c, LineClamp) else c.centre.shape[0]
+        rows.append((0 if isinstance(c, LineClamp) else 1, at[type(c)], at[type(c)] + count))
+        at[type(c)] += count
 
-    def stacked(name: str, width: int) -> np.ndarray:
-        arrays = [getattr(c, name).reshape(-1, width) for c in parts]
-        return np.ascontiguousarray(np.vstack(arrays) if arrays else np.empty((0, width)))
+    def stacked(of: list, name: str, empty: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(np.concatenate([getattr(c, name) for c in of]) if of else empty)
 
+    line_ghosts = next((g for g in ghosts if isinstance(g, LineGhosts)), None)
+    arc_ghosts = next((g for g in ghosts if isinstance(g, ArcGhosts)), None)
     return dict(
         projection=(
-            (p.a, p.d, p.dd, p.lo) if p is not None else (none2, none2, np.empty(0), np.empty(0))
+            (p.kind, p.a, p.d, p.dd, p.lo, p.centre, p.radius, p.start, p.span, p.closed, p.margin)
+            if p is not None
+            else (
+                np.empty(0, dtype=np.int64),
+                none2,
+                none2,
+                none,
+                none,
+                none2,
+                none,
+                none,
+                none,
+                np.empty(0, dtype=np.bool_),
+                0.0,
+            )
         ),
-        clamps=(
-            stacked("a", 2),
-            stacked("d", 2),
-            stacked("dd", 1).ravel().copy(),
-            stacked("normals", 2),
+        has_projection=p is not None,
+        clamp_parts=np.array(rows, dtype=np.int64).reshape(-1, 3),
+        line_clamps=tuple(
+            stacked(lines, k, e)
+            for k, e in (("a", none2), ("d", none2), ("dd", none), ("normals", none2))
         ),
-        clamp_start=np.cumsum([0] + [c.a.shape[0] for c in parts]).astype(np.int64),
-        clamp_margins=np.array([(c.least, c.beyond) for c in parts], dtype=np.float64).reshape(
-            -1, 2
+        line_margins=np.array(
+            [(c.least, c.beyond) if isinstance(c, LineClamp) else (0.0, 0.0) for c in parts],
+            dtype=np.float64,
+        ).reshape(-1, 2),
+        arc_clamps=tuple(
+            stacked(arcs, k, e)
+            for k, e in (
+                ("centre", none2),
+                ("radius", none),
+                ("start", none),
+                ("span", none),
+                ("closed", np.empty(0, dtype=np.bool_)),
+                ("side", none),
+                ("margin", none),
+            )
+        ),
+        ghost_arcs=(
+            (arc_ghosts.centre, arc_ghosts.radius, arc_ghosts.side)
+            if arc_ghosts is not None
+            else (none2, none, none)
         ),
         ghost_lines=(
-            (g.a, g.d, g.dd, g.inward) if g is not None else (none2, none2, np.empty(0), none2)
+            (line_ghosts.a, line_ghosts.d, line_ghosts.dd, line_ghosts.inward, line_ghosts.corners)
+            if line_ghosts is not None
+            else (none2, none2, none, none2, none2)
         ),
-        ghost_h=float(g.h) if g is not None else 0.0,
-        corners=g.corners if g is not None else none2,
-        has_ghosts=g is not None,
+        ghost_h=float(ghosts[0].h) if ghosts else 0.0,
+        ghost_kinds=np.array(
+            [0 if isinstance(g, LineGhosts) else 1 for g in ghosts], dtype=np.int64
+        ),
         raster=(prob.inside.lo, prob.inside.grid),
         raster_cell=float(prob.inside.cell),
     )
 
 
-def _descend_lines(
+def _descend_fused(
     prob: _Problem, form: dict, steps: int, subset, active, label, regions, best, since
 ):
-    """:func:`sr33.samplers._descent_kernels.descend_lines` on ``prob``:
-    its samples moved in place and its last triangulation kept; returns
-    why it stopped, the steps made and the descent's best energy and
-    steps since."""
+    """:func:`sr33.samplers._descent_kernels.descend` on ``prob``: its
+    samples moved in place and its last triangulation kept; returns why it
+    stopped, the steps made and the descent's best energy and steps since."""
     h = prob.h
     watch = prob.watch()
     last = prob.delaunay
@@ -578,7 +633,7 @@ def _descend_lines(
         KEEP_CIRCLE * h**4,
     )
     empty = (np.empty(0, dtype=np.int64), np.empty((0, 2)), np.empty((0, 3), dtype=np.int64))
-    why, ran, best, since, pts, tri, nbr, changed = descend_lines(
+    why, ran, best, since, pts, tri, nbr, changed = descend(
         prob.uv,
         prob.free,
         prob.slide,
@@ -592,18 +647,9 @@ def _descend_lines(
         since,
         params,
         (last[0], last[1], last[2], last[3]) if last is not None else (*empty, empty[2]),
-        form["projection"],
-        form["clamps"],
-        form["clamp_start"],
-        form["clamp_margins"],
-        form["ghost_lines"],
-        form["ghost_h"],
-        form["corners"],
-        form["has_ghosts"],
-        prob.frame,
-        prob.frame_id,
-        form["raster"],
-        form["raster_cell"],
+        frame=prob.frame,
+        frame_id=prob.frame_id,
+        **form,
     )
     if changed:
         prob.delaunay = (last[0], pts, tri, nbr)

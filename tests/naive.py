@@ -314,3 +314,88 @@ def naive_line_project(p, a, d, lo):
     s = ((p - a[which]) * d[which]).sum(axis=-1) / dd[which]
     s = np.clip(s, lo[which], 1.0 - lo[which])
     return a[which] + s[:, None] * d[which]
+
+
+def naive_arc_project(p, centre, radius, start, span, closed, margin):
+    """Nearest point of one arc, kept ``margin`` from an open arc's ends
+    (a point past either end to the nearer end), as numpy (``chart.Arc``'s
+    projection, the code the kernel replaced)."""
+    from sr33 import libm
+
+    d = p - centre
+    ang = libm.arctan2(d[:, 1], d[:, 0])
+    if not closed:
+        rel = (ang - start) % (2 * np.pi)
+        lo, hi = margin / radius, span - margin / radius
+        past = rel > span + (2 * np.pi - span) / 2
+        rel = np.where(past, lo, np.clip(rel, lo, hi))
+        ang = start + rel
+    return centre + radius * np.stack([np.cos(ang), np.sin(ang)], axis=1)
+
+
+def naive_curves_project(p, curves, margin):
+    """Nearest point of the nearest curve: ``curves`` are ("line", a, d, lo)
+    or ("arc", centre, radius, start, span, closed), as numpy (the first of
+    equally near ones)."""
+    dist = np.empty((p.shape[0], len(curves)))
+    for k, c in enumerate(curves):
+        if c[0] == "line":
+            _, a, d, _ = c
+            t = np.clip(((p - a) * d).sum(axis=1) / (d * d).sum(), 0.0, 1.0)
+            q = p - (a + t[:, None] * d)
+            dist[:, k] = np.sqrt((q * q).sum(axis=1))
+        else:
+            dist[:, k] = np.abs(np.linalg.norm(p - c[1], axis=1) - c[2])
+    which = np.argmin(dist, axis=1)
+    out = p.copy()
+    for k, c in enumerate(curves):
+        sel = which == k
+        if not sel.any():
+            continue
+        if c[0] == "line":
+            _, a, d, lo = c
+            t = np.clip(((p[sel] - a) * d).sum(axis=1) / (d * d).sum(), lo, 1.0 - lo)
+            out[sel] = a + t[:, None] * d
+        else:
+            out[sel] = naive_arc_project(p[sel], *c[1:], margin)
+    return out
+
+
+def naive_arc_clamp(p, arcs, sides, margins):
+    """Points kept on the face's side of every arc ((centre, radius, start,
+    span, closed) each), ``margins`` from it, arc after arc, as numpy (the
+    code the kernel replaced)."""
+    from sr33 import libm
+
+    out = p.copy()
+    for (centre, radius, start, span, closed), side, margin in zip(arcs, sides, margins):
+        w = out - centre
+        r = np.linalg.norm(w, axis=1)
+        ang = (libm.arctan2(w[:, 1], w[:, 0]) - start) % (2 * np.pi)
+        within = closed | (ang <= span)
+        inward = side * (radius - r)
+        bad = within & (inward < margin) & (r > 1e-12)
+        if bad.any():
+            out[bad] = centre + w[bad] / r[bad, None] * (radius - side * margin)
+    return out
+
+
+def naive_arc_ghosts(p, arcs, sides, h):
+    """The points of ``p`` on an arc (within 1e-6 h of the nearest) moved h
+    and 2h across it from its centre, arc by arc, as numpy (the code the
+    kernel replaced; ``arcs`` are (centre, radius) each)."""
+    if not arcs:
+        return np.empty((0, 2))
+    d = np.stack([np.abs(np.linalg.norm(p - c, axis=1) - r) for c, r in arcs], axis=1)
+    on = d.min(axis=1) < 1e-6 * h
+    if not on.any():
+        return np.empty((0, 2))
+    p = p[on]
+    which = np.argmin(d[on], axis=1)
+    out = []
+    for k, (c, r) in enumerate(arcs):
+        w = p[which == k] - c
+        w /= np.linalg.norm(w, axis=1)[:, None]
+        for j in (1.0, 2.0):
+            out.append(c + (r + sides[k] * j * h) * w)
+    return np.vstack(out)

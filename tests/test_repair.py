@@ -460,11 +460,23 @@ def test_a_face_still_stuck_gets_new_shaken_starts_kept_only_when_better_on_both
     assert calls == []
 
 
-def slanted_polygon_problem(h: float = 0.05, turn: float = 0.3):
+def slanted_polygon_problem(h: float = 0.05, turn: float = 0.3, hole: bool = False):
     """A hexagon turned off its rows: a square lattice inside it and its
-    edges' samples at equal steps, with the repair's straight-edge
-    callbacks (:mod:`sr33.samplers.chart`)."""
-    from sr33.samplers.chart import Chain, LineClamp, LineGhosts, LineProjection, Raster
+    edges' samples at equal steps, with the repair's planar callbacks
+    (:mod:`sr33.samplers.chart`); with a round hole whose rim's samples
+    slide too."""
+    from sr33.samplers.chart import (
+        Arc,
+        ArcGhosts,
+        Chain,
+        CurveProjection,
+        Joined,
+        LineClamp,
+        LineGhosts,
+        LineProjection,
+        Raster,
+        arc_clamp,
+    )
 
     ang = turn + np.arange(6) * np.pi / 3
     a = 0.5 * np.stack([np.cos(ang), np.sin(ang)], 1)
@@ -499,26 +511,50 @@ def slanted_polygon_problem(h: float = 0.05, turn: float = 0.3):
         anchors=at_corner,
     )
     free = np.r_[depth < 2.5 * h, np.zeros(len(rim), bool)]
+    if not hole:
+        return uv, free, h, args
+    c, radius = np.array([0.05, 0.02]), 0.15
+    arc = Arc(c, radius, 0.0, 2 * np.pi, True, True)
+    from_c = np.linalg.norm(uv - c, axis=1)
+    keep = (from_c > radius + 0.3 * h) | on_rim
+    k = int(round(2 * np.pi * radius / h))
+    t = 2 * np.pi * np.arange(k) / k + 0.1
+    ring = c + radius * np.stack([np.cos(t), np.sin(t)], 1)
+    uv = np.vstack([uv[keep], ring])
+    free = np.r_[
+        free[keep] | ((from_c[keep] < radius + 2.5 * h) & ~on_rim[keep]), np.zeros(k, bool)
+    ]
+    args["slide"] = np.r_[args["slide"][keep], np.ones(k, bool)]
+    args["anchors"] = np.r_[args["anchors"][keep], np.zeros(k, bool)]
+    lines = args["project"]
+    args["project"] = CurveProjection.of_curves(
+        [arc] + [None] * 6, (lines.a, lines.d, lines.dd, lines.lo), 0.3 * h
+    )
+    args["ghosts"] = Joined((ArcGhosts.of([arc], [-1.0], h), args["ghosts"]))
+    args["clamp"] = Chain((arc_clamp([arc], [-1.0], h), *clamps))
+    args["inside"] = Raster(
+        np.vstack([np.stack([a, a + d], 1), np.stack([np.roll(ring, 1, 0), ring], 1)]), h / 4
+    )
     return uv, free, h, args
 
 
-@pytest.mark.parametrize("turn", [0.3, 1.1])
-def test_the_descent_in_one_kernel_moves_the_samples_as_the_python_loop(monkeypatch, turn):
+@pytest.mark.parametrize("turn,hole", [(0.3, False), (1.1, False), (0.7, True)])
+def test_the_descent_in_one_kernel_moves_the_samples_as_the_python_loop(monkeypatch, turn, hole):
     """A face bounded by straight edges is descended in one numba loop
     (:mod:`sr33.samplers._descent_kernels`): bit for bit the samples the
     step-by-step loop gives with the same callbacks as plain functions."""
     import sr33.samplers.repair as rp
 
-    uv, free, h, args = slanted_polygon_problem(turn=turn)
+    uv, free, h, args = slanted_polygon_problem(turn=turn, hole=hole)
     calls = []
-    kernel = rp.descend_lines
+    kernel = rp.descend
 
-    def counted(*a):
-        out = kernel(*a)
+    def counted(*a, **kw):
+        out = kernel(*a, **kw)
         calls.append(out[1])
         return out
 
-    monkeypatch.setattr(rp, "descend_lines", counted)
+    monkeypatch.setattr(rp, "descend", counted)
     fused = repair(uv, free, h, **args)
     assert sum(calls) > 100  # the kernel made the steps
     calls.clear()

@@ -259,3 +259,72 @@ def test_centroids_and_the_rasters_lookup_are_numpys_bit_for_bit(seed, n, m):
     want = np.zeros(len(q), dtype=bool)
     want[ok] = grid[ij[ok, 1].astype(int), ij[ok, 0].astype(int)]
     np.testing.assert_array_equal(grid_lookup(q, lo, cell, grid), want)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(0, 60),
+    lines=st.integers(0, 4),
+    arcs=st.integers(1, 4),
+)
+def test_the_arcs_kernels_are_the_numpy_code_bit_for_bit(seed, n, lines, arcs):
+    """The projection onto a planar face's arcs and straight edges, the
+    arcs' clamp and their ghosts (called at every descent step) give the
+    numpy code's bits, open and closed arcs, points on them and off."""
+    from sr33.samplers import _line_kernels as lk
+    from tests.naive import (
+        naive_arc_clamp,
+        naive_arc_ghosts,
+        naive_curves_project,
+    )
+
+    rng = np.random.default_rng(seed)
+    h = 0.05
+    arc = [
+        (
+            rng.uniform(-0.5, 0.5, 2),
+            float(rng.uniform(0.1, 0.6)),
+            float(rng.uniform(-np.pi, np.pi)),
+            float(rng.uniform(0.3, 2 * np.pi)),
+            bool(rng.random() < 0.4),
+        )
+        for _ in range(arcs)
+    ]
+    line = [
+        ("line", rng.uniform(-1, 1, 2), rng.uniform(-1, 1, 2), float(rng.uniform(0, 0.2)))
+        for _ in range(lines)
+    ]
+    curves = [("arc", *a) for a in arc] + line
+    order = rng.permutation(len(curves))
+    curves = [curves[k] for k in order]
+    p = rng.uniform(-1.2, 1.2, (n, 2))
+    # a third of them on an arc (within rounding: the ghosts' test)
+    k = rng.integers(0, arcs, n // 3)
+    t = rng.uniform(0, 2 * np.pi, n // 3)
+    radius = np.array([a[1] for a in arc])
+    p[: n // 3] = np.array([a[0] for a in arc])[k] + radius[k, None] * np.stack(
+        [np.cos(t), np.sin(t)], 1
+    )
+    m = len(curves)
+    kind = np.array([0 if c[0] == "line" else 1 for c in curves], dtype=np.int64)
+    a, d, dd, lo = np.zeros((m, 2)), np.zeros((m, 2)), np.ones(m), np.zeros(m)
+    centre, rad, start, span = np.zeros((m, 2)), np.zeros(m), np.zeros(m), np.zeros(m)
+    closed = np.zeros(m, dtype=bool)
+    for q, c in enumerate(curves):
+        if c[0] == "line":
+            a[q], d[q], lo[q] = c[1], c[2], c[3]
+            dd[q] = (c[2] * c[2]).sum()
+        else:
+            centre[q], rad[q], start[q], span[q], closed[q] = c[1:]
+    margin = 0.3 * h
+    got = lk.project_curves(p, kind, a, d, dd, lo, centre, rad, start, span, closed, margin)
+    assert got.tobytes() == naive_curves_project(p, curves, margin).tobytes()
+    sides = rng.choice([-1.0, 1.0], arcs)
+    margins = rng.choice([0.25 * h, 0.5 * h], arcs)
+    arrays = [np.array(x) for x in zip(*arc)]
+    got = lk.clamp_arcs(p, *arrays, sides, margins)
+    assert got.tobytes() == naive_arc_clamp(p, arc, sides, margins).tobytes()
+    got = lk.ghosts_arcs(p, arrays[0], arrays[1], sides, h)
+    want = naive_arc_ghosts(p, [(c, r) for c, r, *_ in arc], sides, h)
+    assert got.shape == want.shape and got.tobytes() == want.tobytes()
