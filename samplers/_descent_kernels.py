@@ -32,6 +32,7 @@ from ._repair_kernels import (
     same_points,
 )
 
+TWO_PI = 2 * np.pi
 FINISHED, QHULL, OUT_OF_STEPS = 0, 1, 2  # why :func:`descend` returned
 GHOST, FRAME = -1, -2  # the sample id of a ghost point and of a judged frame point
 
@@ -61,11 +62,57 @@ def _ghost_points(on, ghost_arcs, ghost_lines, ghost_h, kinds):
 
 
 @njit(cache=True)
-def _extended(uv, idx, slide, ghost_arcs, ghost_lines, ghost_h, ghost_kinds, frame, frame_id, h):
-    """The samples ``idx``, the ghosts of their sliding ones and the frame's
-    points within 3 h of their bounding box, with the id of each
-    (``repair._Problem.extended`` without a development's images)."""
+def _turned(x, y, angle):
+    """(x, y) turned about the origin by ``angle`` (``repair.rotate``)."""
+    c = np.cos(angle)
+    s = np.sin(angle)
+    return c * x - s * y, s * x + c * y
+
+
+@njit(cache=True)
+def _images(uv, idx, turn, band, half):
+    """The images of the samples ``idx`` across a development's glued
+    sides, the sample each is and the angle it is turned by
+    (``repair._Problem.images``): those within ``band`` (along their arc)
+    and ``half`` (an angle) of the side at 0 turned by ``+turn``, then those
+    near the side at ``turn`` by ``-turn``."""
     n = idx.size
+    r = np.empty(n)
+    a = np.empty(n)
+    for i in range(n):
+        x, y = uv[idx[i], 0], uv[idx[i], 1]
+        r[i] = np.sqrt(x * x + y * y)
+        a[i] = np.arctan2(y, x) % TWO_PI
+    pos = np.empty((2 * n, 2))
+    of = np.empty(2 * n, dtype=np.int64)
+    angle = np.empty(2 * n)
+    row = 0
+    for sign in (1.0, -1.0):
+        for i in range(n):
+            off = a[i] if sign > 0 else turn - a[i]
+            if off * r[i] < band and off < half and r[i] > 0.0:
+                pos[row, 0], pos[row, 1] = _turned(uv[idx[i], 0], uv[idx[i], 1], sign * turn)
+                of[row] = idx[i]
+                angle[row] = sign * turn
+                row += 1
+    return pos[:row], of[:row], angle[:row]
+
+
+@njit(cache=True)
+def _extended(
+    uv, idx, slide, ghost_arcs, ghost_lines, ghost_h, ghost_kinds, frame, frame_id, h, glue
+):
+    """The samples ``idx``, their images across a development's glued sides
+    (``glue`` = (turn, band, half), turn 0: none), the ghosts of their
+    sliding ones and the frame's points within 3 h of their bounding box,
+    with the id of each and the angle each image is turned by
+    (``repair._Problem.extended``)."""
+    n = idx.size
+    turn, band, half = glue
+    if turn != 0.0:
+        img, img_of, img_angle = _images(uv, idx, turn, band, half)
+    else:
+        img, img_of, img_angle = np.empty((0, 2)), np.empty(0, dtype=np.int64), np.empty(0)
     if ghost_kinds.size:
         count = 0
         for i in range(n):
@@ -97,14 +144,21 @@ def _extended(uv, idx, slide, ghost_arcs, ghost_lines, ghost_h, ghost_kinds, fra
             if f0 >= lo0 and f1 >= lo1 and f0 <= hi0 and f1 <= hi1:
                 kept[k] = True
                 nf += 1
-    total = n + g.shape[0] + nf
+    total = n + img.shape[0] + g.shape[0] + nf
     pts = np.empty((total, 2))
     of = np.empty(total, dtype=np.int64)
+    turned = np.zeros(total)
     for i in range(n):
         pts[i, 0] = uv[idx[i], 0]
         pts[i, 1] = uv[idx[i], 1]
         of[i] = idx[i]
     row = n
+    for i in range(img.shape[0]):
+        pts[row, 0] = img[i, 0]
+        pts[row, 1] = img[i, 1]
+        of[row] = img_of[i]
+        turned[row] = img_angle[i]
+        row += 1
     for i in range(g.shape[0]):
         pts[row, 0] = g[i, 0]
         pts[row, 1] = g[i, 1]
@@ -116,7 +170,7 @@ def _extended(uv, idx, slide, ghost_arcs, ghost_lines, ghost_h, ghost_kinds, fra
             pts[row, 1] = frame[k, 1]
             of[row] = frame_id
             row += 1
-    return pts, of
+    return pts, of, turned
 
 
 @njit(cache=True)
@@ -142,11 +196,47 @@ def _scatter(uv, mask, values):
 
 
 @njit(cache=True)
+def _radial(p, lo, hi):
+    """``chart.RadialClamp``: points moved to a distance from the origin
+    within [lo, hi] (the origin stays)."""
+    out = p.copy()
+    for i in range(p.shape[0]):
+        x, y = p[i, 0], p[i, 1]
+        r = np.sqrt(x * x + y * y)
+        f = min(max(r, lo), hi) / max(r, 1e-300)
+        if r > 0:
+            out[i, 0] = x * f
+            out[i, 1] = y * f
+    return out
+
+
+@njit(cache=True)
+def _inside(c, kind, raster, raster_cell, sector):
+    """Which points ``c`` are in the face: by its raster (``kind`` 0,
+    ``chart.Raster``) or in an annular sector (1: outer, inner, theta,
+    full; ``chart.Sector``)."""
+    if kind == 0:
+        lo, grid = raster
+        return grid_lookup(c, lo, raster_cell, grid)
+    outer, inner, theta, full = sector
+    out = np.empty(c.shape[0], dtype=np.bool_)
+    for i in range(c.shape[0]):
+        x, y = c[i, 0], c[i, 1]
+        r = np.sqrt(x * x + y * y)
+        ok = r < outer and r > inner
+        if ok and not full:
+            ok = np.arctan2(y, x) % TWO_PI < theta
+        out[i] = ok
+    return out
+
+
+@njit(cache=True)
 def _clamped(q, parts, line_clamps, line_margins, arc_clamps):
     """``q`` through every clamp of ``parts`` in order (rows: kind, first,
     end; kind 0 the straight edges ``line_clamps`` [first, end) with that
     part's (least, beyond) in ``line_margins``, kind 1 the arcs
-    ``arc_clamps`` [first, end))."""
+    ``arc_clamps`` [first, end), kind 2 a distance from the origin within
+    that part's (lo, hi) in ``line_margins``, ``chart.RadialClamp``)."""
     ca, cd, cdd, cn = line_clamps
     centre, radius, start, span, closed, side, margin = arc_clamps
     for k in range(parts.shape[0]):
@@ -161,6 +251,8 @@ def _clamped(q, parts, line_clamps, line_margins, arc_clamps):
                 line_margins[k, 0],
                 line_margins[k, 1],
             )
+        elif parts[k, 0] == 2:
+            q = _radial(q, line_margins[k, 0], line_margins[k, 1])
         else:
             q = clamp_arcs(
                 q,
@@ -202,8 +294,11 @@ def descend(
     ghost_kinds,
     frame,
     frame_id,
+    inside_kind,
     raster,
     raster_cell,
+    sector,
+    glue,
 ):
     """Up to ``steps`` steps of the repair's descent (``repair._steps``), in
     place on ``uv``, for a planar face bounded by straight edges and arcs.
@@ -216,7 +311,9 @@ def descend(
     centre, radius, start, span, closed, margin); the clamps as
     :func:`_clamped` takes them; the ghosts' arcs (centre, radius, side),
     straight edges (a, d, dd, inward, corners), h and kinds in order (see
-    :func:`_ghost_points`); ``raster`` = (lo, grid) with its cell.
+    :func:`_ghost_points`); the inside test as :func:`_inside` takes it;
+    ``glue`` = (turn, band, half, middle) of a development whose sides are
+    glued (turn 0: none; ``repair._Problem.images`` and ``wrap``).
 
     Returns why it stopped (``FINISHED``: the descent is over; ``QHULL``:
     the next step needs Qhull; ``OUT_OF_STEPS``), the steps made, the
@@ -239,15 +336,25 @@ def descend(
     ) = params
     last_of, last_pts, last_tri, last_nbr = last
     kind, pa, pd, pdd, plo, centre, radius, start, span, closed, margin = projection
-    lo, grid = raster
+    turn = glue[0]
     n = uv.shape[0]
     move = free | slide
     hold = slide | anchor
     changed = False
     done = 0
     while done < steps:
-        pts, of = _extended(
-            uv, idx, slide, ghost_arcs, ghost_lines, ghost_h, ghost_kinds, frame, frame_id, h
+        pts, of, turned = _extended(
+            uv,
+            idx,
+            slide,
+            ghost_arcs,
+            ghost_lines,
+            ghost_h,
+            ghost_kinds,
+            frame,
+            frame_id,
+            h,
+            (glue[0], glue[1], glue[2]),
         )
         if pts.shape[0] < 3:
             return FINISHED, done, best, since, last_pts, last_tri, last_nbr, changed
@@ -261,7 +368,7 @@ def descend(
             tri, nbr = canonical_order(tri, nbr)
         last_pts, last_tri, last_nbr, changed = pts, tri, nbr, True
         # the face's triangles: inside it, or on its judged frame
-        inside = grid_lookup(centroids(pts, tri), lo, raster_cell, grid)
+        inside = _inside(centroids(pts, tri), inside_kind, raster, raster_cell, sector)
         count = 0
         for t in range(tri.shape[0]):
             if not inside[t]:
@@ -289,6 +396,9 @@ def descend(
             since += 1
             if since >= 15:
                 return FINISHED, done, best, since, last_pts, last_tri, last_nbr, changed
+        if turn != 0.0:  # an image's gradient, turned back onto its sample
+            for k in range(gp.shape[0]):
+                gp[k, 0], gp[k, 1] = _turned(gp[k, 0], gp[k, 1], -turned[k])
         grad = gathered_gradient(of, gp, n, move)
         moved = descent_step(uv, grad, move, label, regions, step)
         if not moved.any():
@@ -317,5 +427,13 @@ def descend(
                 shifted,
                 _clamped(_gather(uv, shifted), clamp_parts, line_clamps, line_margins, arc_clamps),
             )
+        if turn != 0.0:  # back into the sector
+            for v in range(n):
+                if moved[v]:
+                    a = np.arctan2(uv[v, 1], uv[v, 0]) % TWO_PI
+                    k = 0.0
+                    if a >= turn:
+                        k = 1.0 if a >= glue[3] else -1.0
+                    uv[v, 0], uv[v, 1] = _turned(uv[v, 0], uv[v, 1], k * turn)
         done += 1
     return OUT_OF_STEPS, done, best, since, last_pts, last_tri, last_nbr, changed

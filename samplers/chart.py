@@ -349,15 +349,41 @@ class Joined:
         return np.vstack([f(p) for f in self.parts])
 
 
-def radial_clamp(lo: float, hi: float):
+def radial_clamp(lo: float, hi: float) -> RadialClamp:
     """Keep points at a distance from the origin within [lo, hi] (the origin stays)."""
+    return RadialClamp(float(lo), float(hi))
 
-    def clamp(p: np.ndarray) -> np.ndarray:
+
+@dataclass(frozen=True, eq=False)
+class RadialClamp:
+    """Points moved to a distance from the origin within [lo, hi] (the origin stays)."""
+
+    lo: float
+    hi: float
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
         r = np.linalg.norm(p, axis=1)
-        s = np.clip(r, lo, hi) / np.maximum(r, 1e-300)
+        s = np.clip(r, self.lo, self.hi) / np.maximum(r, 1e-300)
         return np.where((r > 0)[:, None], p * s[:, None], p)
 
-    return clamp
+
+@dataclass(frozen=True, eq=False)
+class Sector:
+    """Inside test of an annular sector about the origin: farther than
+    ``inner`` and nearer than ``outer``, at an angle in [0, ``theta``) unless
+    ``full`` (a disk or an annulus; a cone's development)."""
+
+    outer: float
+    inner: float
+    theta: float
+    full: bool
+
+    def __call__(self, c: np.ndarray) -> np.ndarray:
+        r = np.linalg.norm(c, axis=1)
+        if self.full:
+            return (r < self.outer) & (r > self.inner)
+        a = libm.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
+        return (r < self.outer) & (r > self.inner) & (a < self.theta)
 
 
 def segment_distance(p: np.ndarray, seg: np.ndarray, step: float) -> np.ndarray:

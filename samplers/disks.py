@@ -44,7 +44,7 @@ from scipy.spatial import Delaunay
 from sr33.mesh import dot, flipped_triangles, near_cocircular, norm, triangle_ratios
 
 from .adjacency import EdgeFaces
-from .chart import halving_count, radial_clamp
+from .chart import Sector, halving_count, radial_clamp
 from .faces import (
     cap_rim,
     goes_round,
@@ -348,9 +348,7 @@ def _layout_with(
     lo = radii[1] + 0.25 * t if len(radii) > 1 else 0.0
     clamp = radial_clamp(lo, radii[0] - 0.25 * t)
 
-    def inside(c: np.ndarray) -> np.ndarray:
-        r = np.linalg.norm(c, axis=1)
-        return (r < radii[0]) & (r > (radii[1] if len(radii) > 1 else -1.0))
+    inside = Sector(radii[0], radii[1] if len(radii) > 1 else -1.0, 2 * math.pi, True)
 
     bad = 0
     if free.any():

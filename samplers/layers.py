@@ -44,6 +44,7 @@ from .chart import (
     LineGhosts,
     LineProjection,
     Raster,
+    Sector,
     arc_clamp,
     arc_sides,
     as_points,
@@ -1640,10 +1641,7 @@ def _repair_developed(
     end, hole = _development_end(inner, sin_a)
     allp = np.vstack([uv, rim, end])
 
-    def inside(c: np.ndarray) -> np.ndarray:
-        r = np.linalg.norm(c, axis=1)
-        a = libm.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
-        return (r < slant) & (r > hole) & (full | (a < theta))
+    inside = Sector(slant, hole, theta, full)
 
     n = uv.shape[0]
     # where the rings break Condition III-ii: the triangles to mend (across the

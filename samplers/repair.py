@@ -72,7 +72,9 @@ from .chart import (
     LineClamp,
     LineGhosts,
     LineProjection,
+    RadialClamp,
     Raster,
+    Sector,
 )
 
 TARGET = 0.78  # the descent pushes every ratio below this
@@ -514,8 +516,8 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
 def _kernel_form(prob: _Problem) -> dict | None:
     """A problem's callbacks as the arrays of
     :func:`sr33.samplers._descent_kernels.descend`, when every one is a
-    planar form of :mod:`sr33.samplers.chart` (a planar face bounded by
-    straight edges and arcs, no development), else None."""
+    form of :mod:`sr33.samplers.chart` (a planar face bounded by straight
+    edges and arcs, a disk's or a cone development's sector), else None."""
     parts = prob.clamp.parts if isinstance(prob.clamp, Chain) else (prob.clamp,)
     parts = tuple(c for c in parts if c is not None)
     ghosts = prob.ghosts.parts if isinstance(prob.ghosts, Joined) else (prob.ghosts,)
@@ -524,10 +526,9 @@ def _kernel_form(prob: _Problem) -> dict | None:
     if isinstance(p, LineProjection):
         p = CurveProjection.of_lines(p)
     if (
-        prob.turn is not None
-        or not isinstance(prob.inside, Raster)
+        not isinstance(prob.inside, (Raster, Sector))
         or not (isinstance(p, CurveProjection) or (p is None and not prob.slide.any()))
-        or not all(isinstance(c, (LineClamp, ArcClamp)) for c in parts)
+        or not all(isinstance(c, (LineClamp, ArcClamp, RadialClamp)) for c in parts)
         or not all(isinstance(g, (LineGhosts, ArcGhosts)) for g in ghosts)
         or sum(isinstance(g, LineGhosts) for g in ghosts) > 1
         or sum(isinstance(g, ArcGhosts) for g in ghosts) > 1
@@ -536,12 +537,19 @@ def _kernel_form(prob: _Problem) -> dict | None:
         return None
     none2 = np.empty((0, 2))
     none = np.empty(0)
+    no_grid = np.zeros((1, 1), dtype=np.bool_)
+    inside = prob.inside
     lines = [c for c in parts if isinstance(c, LineClamp)]
     arcs = [c for c in parts if isinstance(c, ArcClamp)]
-    rows, at = [], {LineClamp: 0, ArcClamp: 0}
+    rows, at = [], {LineClamp: 0, ArcClamp: 0, RadialClamp: 0}
     for c in parts:
-        count = c.a.shape[0] if isinstance(c, LineClamp) else c.centre.shape[0]
-        rows.append((0 if isinstance(c, LineClamp) else 1, at[type(c)], at[type(c)] + count))
+        if isinstance(c, LineClamp):
+            kind, count = 0, c.a.shape[0]
+        elif isinstance(c, ArcClamp):
+            kind, count = 1, c.centre.shape[0]
+        else:
+            kind, count = 2, 1
+        rows.append((kind, at[type(c)], at[type(c)] + count))
         at[type(c)] += count
 
     def stacked(of: list, name: str, empty: np.ndarray) -> np.ndarray:
@@ -574,7 +582,14 @@ def _kernel_form(prob: _Problem) -> dict | None:
             for k, e in (("a", none2), ("d", none2), ("dd", none), ("normals", none2))
         ),
         line_margins=np.array(
-            [(c.least, c.beyond) if isinstance(c, LineClamp) else (0.0, 0.0) for c in parts],
+            [
+                (c.least, c.beyond)
+                if isinstance(c, LineClamp)
+                else (c.lo, c.hi)
+                if isinstance(c, RadialClamp)
+                else (0.0, 0.0)
+                for c in parts
+            ],
             dtype=np.float64,
         ).reshape(-1, 2),
         arc_clamps=tuple(
@@ -603,8 +618,24 @@ def _kernel_form(prob: _Problem) -> dict | None:
         ghost_kinds=np.array(
             [0 if isinstance(g, LineGhosts) else 1 for g in ghosts], dtype=np.int64
         ),
-        raster=(prob.inside.lo, prob.inside.grid),
-        raster_cell=float(prob.inside.cell),
+        inside_kind=0 if isinstance(inside, Raster) else 1,
+        raster=(inside.lo, inside.grid) if isinstance(inside, Raster) else (none, no_grid),
+        raster_cell=float(inside.cell) if isinstance(inside, Raster) else 1.0,
+        sector=(
+            (float(inside.outer), float(inside.inner), float(inside.theta), bool(inside.full))
+            if isinstance(inside, Sector)
+            else (0.0, 0.0, 0.0, True)
+        ),
+        glue=(
+            (
+                float(prob.turn),
+                IMAGE_BAND * prob.h,
+                glue_reach(prob.turn),
+                0.5 * (prob.turn + 2 * np.pi),
+            )
+            if prob.turn is not None
+            else (0.0, 0.0, 0.0, 0.0)
+        ),
     )
 
 

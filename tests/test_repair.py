@@ -566,3 +566,47 @@ def test_the_descent_in_one_kernel_moves_the_samples_as_the_python_loop(monkeypa
     assert fused.uv.tobytes() == python.uv.tobytes()
     assert fused.origin.tobytes() == python.origin.tobytes()
     assert (fused.bad, fused.worst) == (python.bad, python.worst)
+
+
+@pytest.mark.parametrize("theta", [2.0, 2 * np.pi])
+def test_the_descent_in_one_kernel_turns_a_developments_images_as_the_python_loop(
+    monkeypatch, theta
+):
+    """A cone's development (its sides glued: images, gradients turned back,
+    samples wrapped into the sector) and a disk (``theta`` 2 pi, no cut),
+    with an annular sector's inside test and a radial clamp: the fused
+    descent gives the step-by-step loop's samples bit for bit."""
+    import sr33.samplers.repair as rp
+    from sr33.samplers.chart import Sector, radial_clamp
+
+    m = 20
+    a = (np.arange(m) + 0.5) * theta / m
+    uv = np.concatenate([r * np.stack([np.cos(a), np.sin(a)], 1) for r in np.arange(10.0, 15.0)])
+    uv[2 * m] = 12.0 * np.array([np.cos(0.05 * theta / m), np.sin(0.05 * theta / m)])
+    uv[3 * m + 4] *= 0.93
+    r = np.linalg.norm(uv, axis=1)
+    full = theta >= 2 * np.pi
+    args = dict(
+        inside=Sector(14.0, 10.0, theta, full),
+        clamp=radial_clamp(10.25, 13.75),
+        turn=None if full else theta,
+    )
+    free = (r > 10.5) & (r < 13.5)
+    calls = []
+    kernel = rp.descend
+
+    def counted(*a, **kw):
+        out = kernel(*a, **kw)
+        calls.append(out[1])
+        return out
+
+    monkeypatch.setattr(rp, "descend", counted)
+    fused = repair(uv, free, 1.0, **args)
+    assert sum(calls) > 20
+    calls.clear()
+    plain = {**args, "inside": (lambda f: lambda p: f(p))(args["inside"])}
+    python = repair(uv, free, 1.0, **plain)
+    assert not calls
+    assert fused.uv.tobytes() == python.uv.tobytes()
+    assert fused.origin.tobytes() == python.origin.tobytes()
+    assert (fused.bad, fused.worst) == (python.bad, python.worst)
