@@ -328,3 +328,39 @@ def test_the_arcs_kernels_are_the_numpy_code_bit_for_bit(seed, n, lines, arcs):
     got = lk.ghosts_arcs(p, arrays[0], arrays[1], sides, h)
     want = naive_arc_ghosts(p, [(c, r) for c, r, *_ in arc], sides, h)
     assert got.shape == want.shape and got.tobytes() == want.tobytes()
+
+
+def neighbours_of(tri: np.ndarray) -> np.ndarray:
+    """The triangle across the edge opposite each corner (-1 on the hull)."""
+    where = {}
+    for t, (a, b, c) in enumerate(tri.tolist()):
+        for k, e in enumerate(((b, c), (c, a), (a, b))):
+            where.setdefault(frozenset(e), []).append((t, k))
+    nbr = np.full(tri.shape, -1)
+    for uses in where.values():
+        if len(uses) == 2:
+            (t, k), (u, j) = uses
+            nbr[t, k], nbr[u, j] = u, t
+    return nbr
+
+
+def test_a_chain_of_flat_hull_triangles_is_peeled_whole():
+    """A row of collinear samples on the hull (a local window cut off along
+    a lattice's diagonal), triangulated as Qhull's ``Qt`` may: a chain of
+    flat triangles, the second on the hull only once the first goes.  All
+    of them go, every sample stays a corner, and the triangulation can then
+    be carried to the next step by edge flips (on block_two_holes the
+    chain's second triangle sent 5,776 of 7,928 steps to Qhull)."""
+    from sr33.samplers._repair_kernels import delaunay_flips
+    from sr33.samplers.repair import _doubled_areas, _without_flat_hull
+
+    # the row P0..P3 on the line y = x, the face below it
+    pts = np.array([[0, 0], [1, 1], [2, 2], [3, 3], [1, 0], [2, 1], [3, 2], [3, 0]], dtype=float)
+    real = [[0, 4, 1], [1, 4, 5], [1, 5, 2], [2, 5, 6], [2, 6, 3], [4, 7, 5], [5, 7, 6]]
+    chain = [[0, 1, 3], [1, 2, 3]]  # flat: the first has the hull edge P0-P3
+    tri = np.array(real + chain)
+    tri, nbr = _without_flat_hull(pts, tri, neighbours_of(tri), 1e-9)
+    assert sorted(map(tuple, tri.tolist())) == sorted(map(tuple, real))
+    assert (np.abs(_doubled_areas(pts, tri)) > 1e-9).all()
+    np.testing.assert_array_equal(nbr, neighbours_of(tri))  # renumbered
+    assert delaunay_flips(pts, tri, nbr, 1e-9, 1e-10) is not None
