@@ -1706,3 +1706,37 @@ def test_a_bitten_balls_pole_at_the_maps_centre_of_projection_is_left_out_of_the
     assert "sphere chart" in {x["kind"] for x in r.meta["repairs"]}
     top = np.array([0.0, 0.0, 0.4])
     assert np.linalg.norm(r.points - top, axis=1).min() < 1e-9  # the pole's sample stays
+
+
+def test_the_apex_judge_measures_a_triangle_by_the_geodesic_distances_of_its_corners():
+    """Round the apex of a narrow cone (the library cone, 0.5 by 1.5: its
+    development 114°) an edge of the intrinsic Delaunay triangulation may
+    run the longer way round the apex.  The geodesic check measures the
+    distance between the corners, the shorter way: the judge does too (the
+    cone turned b had a triangle of 0.82 by its edges and 0.870 by the
+    check, and its rings were kept with it)."""
+    import math
+
+    from sr33.samplers.layers import _apex_triangulation, _apex_worst
+
+    sin_a = 0.5 / math.hypot(0.5, 1.5)
+    rho = np.array([0.65, 0.984, 1.529, 1.635, 1.675, 1.849, 2.716, 2.757, 2.793])
+    ang = np.array([4.1233, 0.9817, 3.9979, 2.4401, 1.1378, 5.9875, 1.3161, 5.4769, 4.0329])
+    r, tris, lengths, _ = _apex_triangulation(rho, ang, np.empty(0), 62.0, sin_a, 1.0)
+    theta = 2 * math.pi * sin_a
+    psi = np.r_[0.0, ang * sin_a] % theta
+
+    def apart(i, j):
+        d = abs(psi[i] - psi[j]) % theta
+        d = min(d, theta - d)
+        return math.sqrt(r[i] ** 2 + r[j] ** 2 - 2 * r[i] * r[j] * math.cos(d))
+
+    by_corners = max(
+        sorted(apart(x[q], x[(q + 1) % 3]) for q in range(3))[1]
+        / max(apart(x[q], x[(q + 1) % 3]) for q in range(3))
+        for x in tris.tolist()
+    )
+    edges = np.sort(lengths, axis=1)
+    assert (edges[:, 1] / edges[:, 2]).max() < 0.85  # the edges' own lengths miss it
+    assert _apex_worst(rho, ang, np.empty(0), 62.0, sin_a, 1.0) == pytest.approx(by_corners)
+    assert by_corners > 0.865
