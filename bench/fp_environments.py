@@ -12,7 +12,13 @@ default sampling is made in a fresh process under each environment:
 * ``other-libm``: numpy's and Python's sine, cosine, arc functions,
   exponentials and logarithms answer one unit in the last place off for
   about half of all inputs (chosen by a hash of the input's bits), as
-  another libm or numpy's AVX-512 paths would.
+  another libm would (the angles of :mod:`sr33.libm`, numba loops calling
+  the C library, are not perturbed);
+* ``no-avx512``: numpy told to leave its AVX-512 loops
+  (``NPY_DISABLE_CPU_FEATURES``, numpy 2.4's names), as on a processor
+  without them: its arctan2 and arccos then give the C library's bits,
+  which differ from its AVX-512 ones in the last place for some inputs
+  (before :mod:`sr33.libm`, a cone's sampling differed between the two).
 
 For each distinct sampling (by the md5 of its points' bytes) the
 acceptance figures are measured: sample count, Condition III by the
@@ -41,6 +47,7 @@ ENVIRONMENTS = {
     "default": {},
     "blas-sse3": {"OPENBLAS_CORETYPE": "Prescott", "OPENBLAS_NUM_THREADS": "1"},
     "other-libm": {"SR33_BENCH_PERTURB_LIBM": "1"},
+    "no-avx512": {"NPY_DISABLE_CPU_FEATURES": "AVX512_ICL X86_V4"},
 }
 
 # the child: optionally perturb the transcendental functions, sample, save
