@@ -1028,7 +1028,8 @@ class _ConeRings:
     rows: int
     bad: int | None
     worst: float | None
-    judged: float = 0.0  # :func:`_developed_worst`
+    judged: float = 0.0  # :func:`_rings_judged`: the larger ...
+    lenient: float = 0.0  # ... and the smaller measure round the apex
 
 
 def _developed(rho, ang, sin_a: float) -> np.ndarray:
@@ -1194,6 +1195,7 @@ def _apex_worst(
     t: float,
     judged: float | None = None,
     zone: float | None = None,
+    corners: bool = False,
 ) -> float:
     """The worst Condition III-ii ratio of the intrinsic Delaunay triangles
     round a cone's apex (centroid within ``judged`` t of it, by default
@@ -1213,26 +1215,34 @@ def _apex_worst(
     triangle flat).  A turned conebox's 181° cone had a sliver of 0.979
     there (0.911 before its development was glued without overlap) that no
     planar picture shows.
+
+    Round the apex of a narrow cone an edge of that triangulation may run
+    the longer way round it; the geodesic check measures a triangle by the
+    distances between its corners, the shorter way.  With ``corners`` the
+    triangles are measured so (the cone 0.5 x 1.5 turned b: sides 1.025,
+    1.090 and 1.328 t, 0.82 by its edges; the last pair 1.247 t apart the
+    other way, 0.874; the check read 0.870).  Neither measure is the
+    check's everywhere: on a slender cone (the survey's "ring of four
+    faces") a triangle whose long edge is nearly twice the short way read
+    0.984 by its corners, and the check, whose Delaunay triangles there
+    are others, 0.851; :func:`lattice_cone_faces` takes both.
     """
-    r, tris, _, _ = _apex_triangulation(rho, ang, rim_ang, slant, sin_a, t, zone)
+    r, tris, lengths, _ = _apex_triangulation(rho, ang, rim_ang, slant, sin_a, t, zone)
     judged = APEX_JUDGED_FROM if judged is None else judged
     inner = r[tris].mean(axis=1) < judged * t if tris.size else np.empty(0, bool)
     if not inner.any():
         return 0.0
-    # each triangle judged by the geodesic distances between its corners, as
-    # the geodesic check measures them: round the apex of a narrow cone an
-    # edge of the intrinsic triangulation may run the longer way round it
-    # (the cone 0.5 x 1.5 turned b: sides 1.025, 1.090 and 1.328 t, 0.82 by
-    # its edges; the last pair is 1.247 t apart the other way, 0.874, and
-    # the check read 0.870 there)
-    _, psi, theta = _apex_zone(rho, ang, rim_ang, slant, sin_a, t, zone)
-    tris = tris[inner]
-    sides = np.sort(
-        np.stack(
+    if corners:
+        # by the geodesic distances between the corners, the shorter way
+        # round the apex, as the geodesic check measures a triangle's sides
+        _, psi, theta = _apex_zone(rho, ang, rim_ang, slant, sin_a, t, zone)
+        tris = tris[inner]
+        lengths = np.stack(
             [_shortest(r, psi, theta, tris[:, q], tris[:, (q + 1) % 3]) for q in range(3)], axis=1
-        ),
-        axis=1,
-    )
+        )
+    else:
+        lengths = lengths[inner]
+    sides = np.sort(lengths, axis=1)
     return float((sides[:, 1] / sides[:, 2]).max())
 
 
@@ -1293,7 +1303,7 @@ def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float,
     )
     # stuck: once more, wider, the apex's neighbourhood settled
     args = (rim_ang, slant, sin_a, t, inner)
-    judged = _rings_judged(got, *args)
+    judged, lenient = _rings_judged(got, *args)
     if got[4] >= broken_at:
         wide = _repair_developed(
             *got[:3],
@@ -1308,10 +1318,10 @@ def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float,
         )
         # by the whole development and the apex (the wider repair keeps the
         # apex's neighbourhood and does not judge the triangles there)
-        wide_judged = _rings_judged(wide, *args)
+        wide_judged, wide_lenient = _rings_judged(wide, *args)
         if wide_judged < judged:
-            got, judged = wide, wide_judged
-    return _ConeRings(got[0], got[1], got[2], nrows, got[3], got[4], judged)
+            got, judged, lenient = wide, wide_judged, wide_lenient
+    return _ConeRings(got[0], got[1], got[2], nrows, got[3], got[4], judged, lenient)
 
 
 def _phased(ang: np.ndarray, rim: np.ndarray) -> np.ndarray:
@@ -1342,14 +1352,18 @@ def _phased(ang: np.ndarray, rim: np.ndarray) -> np.ndarray:
     return split_gaps % (2 * math.pi)
 
 
-def _rings_judged(got, rim_ang, slant: float, sin_a: float, t: float, inner) -> float:
+def _rings_judged(got, rim_ang, slant: float, sin_a: float, t: float, inner) -> tuple[float, float]:
     """The worst ratio of a cone's repaired rings ``got`` (rho, ang, ...): on
     the whole development (:func:`_developed_worst`) and, with an apex,
-    round it (:func:`_apex_worst`)."""
+    round it (:func:`_apex_worst`), its triangles measured by their corners'
+    distances and by their edges (:func:`_apex_worst`'s ``corners``): the
+    larger and the smaller of the two."""
     judged = _developed_worst(got[0], got[1], rim_ang, slant, sin_a, t, inner)
-    if inner is None:
-        judged = max(judged, _apex_worst(got[0], got[1], rim_ang, slant, sin_a, t))
-    return judged
+    if inner is not None:
+        return judged, judged
+    by_edges = _apex_worst(got[0], got[1], rim_ang, slant, sin_a, t)
+    by_corners = _apex_worst(got[0], got[1], rim_ang, slant, sin_a, t, corners=True)
+    return max(judged, by_edges, by_corners), max(judged, min(by_edges, by_corners))
 
 
 def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
@@ -1446,13 +1460,15 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
             lambda p: p.moved == 0,
         )
         # the rows near the apex end their columns by the first of
-        # APEX_END_LIMITS whose repaired rings meet APEX_GOOD (else the lowest)
+        # APEX_END_LIMITS whose repaired rings meet APEX_GOOD by both
+        # measures round the apex (else the lowest by the smaller: the
+        # geodesic check's triangles there lie between the two measures)
         args = (plan, reach, rim_ang, slant, sin_a, t, inner)
         limits, got = _first_passing(
             APEX_END_LIMITS,
             lambda lim, args=args: _cone_rings(*args, lim),
             lambda g: round(g.judged, 9) < APEX_GOOD,
-            rank=lambda g: round(g.judged, 9),
+            rank=lambda g: round(g.lenient, 9),
         )
         rho_a, ang_a, row_a = got.rho, got.ang, got.row
         nrows, bad, worst = got.rows, got.bad, got.worst

@@ -1708,11 +1708,11 @@ def test_a_bitten_balls_pole_at_the_maps_centre_of_projection_is_left_out_of_the
     assert np.linalg.norm(r.points - top, axis=1).min() < 1e-9  # the pole's sample stays
 
 
-def test_the_apex_judge_measures_a_triangle_by_the_geodesic_distances_of_its_corners():
+def test_the_apex_judge_can_measure_a_triangle_by_the_geodesic_distances_of_its_corners():
     """Round the apex of a narrow cone (the library cone, 0.5 by 1.5: its
     development 114°) an edge of the intrinsic Delaunay triangulation may
     run the longer way round the apex.  The geodesic check measures the
-    distance between the corners, the shorter way: the judge does too (the
+    distance between the corners, the shorter way: the judge can too (the
     cone turned b had a triangle of 0.82 by its edges and 0.870 by the
     check, and its rings were kept with it)."""
     import math
@@ -1738,5 +1738,8 @@ def test_the_apex_judge_measures_a_triangle_by_the_geodesic_distances_of_its_cor
     )
     edges = np.sort(lengths, axis=1)
     assert (edges[:, 1] / edges[:, 2]).max() < 0.85  # the edges' own lengths miss it
-    assert _apex_worst(rho, ang, np.empty(0), 62.0, sin_a, 1.0) == pytest.approx(by_corners)
+    got = _apex_worst(rho, ang, np.empty(0), 62.0, sin_a, 1.0, corners=True)
+    assert got == pytest.approx(by_corners)
     assert by_corners > 0.865
+    # by their edges, as before (the judge takes both, lattice_cone_faces)
+    assert _apex_worst(rho, ang, np.empty(0), 62.0, sin_a, 1.0) < 0.85
