@@ -22,7 +22,7 @@ from sr33.jit import njit
 
 from ._line_kernels import clamp, clamp_arcs, ghosts, ghosts_arcs, project_curves
 from ._repair_kernels import (
-    canonical_order,
+    canonical_reorder,
     centroids,
     delaunay_flips,
     descent_step,
@@ -365,7 +365,7 @@ def descend(
             return QHULL, done, best, since, last_pts, last_tri, last_nbr, changed
         tri, nbr, flips = flipped
         if flips:
-            tri, nbr = canonical_order(tri, nbr)
+            tri, nbr = canonical_reorder(tri, nbr, last_tri)
         last_pts, last_tri, last_nbr, changed = pts, tri, nbr, True
         # the face's triangles: inside it, or on its judged frame
         inside = _inside(centroids(pts, tri), inside_kind, raster, raster_cell, sector)

@@ -130,7 +130,7 @@ def test_flips_from_the_last_triangulation_give_qhulls_triangles(seed, side, mov
     the Delaunay triangles Qhull gives for the new ones (the same rows, the
     same neighbours, in canonical order), or give up (None): never another
     triangulation."""
-    from sr33.samplers._repair_kernels import canonical_order, delaunay_flips
+    from sr33.samplers._repair_kernels import canonical_order, canonical_reorder, delaunay_flips
 
     rng = np.random.default_rng(seed)
     g = np.stack(np.meshgrid(np.arange(side), np.arange(side)), -1).reshape(-1, 2).astype(float)
@@ -147,6 +147,10 @@ def test_flips_from_the_last_triangulation_give_qhulls_triangles(seed, side, mov
         want_t, want_n = _canonical_delaunay(after)
         np.testing.assert_array_equal(got_t, want_t)
         np.testing.assert_array_equal(got_n, want_n)
+        # the descent's merge of the rows the flips left with the others sorted
+        re_t, re_n = canonical_reorder(out[0], out[1], tri)
+        np.testing.assert_array_equal(re_t, want_t)
+        np.testing.assert_array_equal(re_n, want_n)
     np.testing.assert_array_equal(tri, _canonical_delaunay(before)[0])  # input left alone
 
 
