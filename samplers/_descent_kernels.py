@@ -24,7 +24,7 @@ from ._line_kernels import clamp, clamp_arcs, ghosts, ghosts_arcs, project_curve
 from ._repair_kernels import (
     canonical_reorder,
     centroids,
-    delaunay_flips,
+    delaunay_flips_since,
     descent_step,
     energy_terms,
     gathered_gradient,
@@ -360,7 +360,7 @@ def descend(
             return FINISHED, done, best, since, last_pts, last_tri, last_nbr, changed
         if last_of.size == 0 or not same_points(last_of, of, last_pts, pts, keep_move):
             return QHULL, done, best, since, last_pts, last_tri, last_nbr, changed
-        flipped = delaunay_flips(pts, last_tri, last_nbr, keep_area, keep_circle)
+        flipped = delaunay_flips_since(pts, last_pts, last_tri, last_nbr, keep_area, keep_circle)
         if flipped is None:
             return QHULL, done, best, since, last_pts, last_tri, last_nbr, changed
         tri, nbr, flips = flipped

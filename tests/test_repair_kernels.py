@@ -123,25 +123,41 @@ def _canonical_delaunay(pts):
 
 @settings(max_examples=40, deadline=None)
 @given(
-    seed=st.integers(0, 2**32 - 1), side=st.integers(3, 14), move=st.sampled_from([0.01, 0.05, 0.2])
+    seed=st.integers(0, 2**32 - 1),
+    side=st.integers(3, 14),
+    move=st.sampled_from([0.01, 0.05, 0.2]),
+    share=st.sampled_from([1.0, 0.15]),
 )
-def test_flips_from_the_last_triangulation_give_qhulls_triangles(seed, side, move):
+def test_flips_from_the_last_triangulation_give_qhulls_triangles(seed, side, move, share):
     """Lawson's flips from the triangles of the points' last positions end at
     the Delaunay triangles Qhull gives for the new ones (the same rows, the
     same neighbours, in canonical order), or give up (None): never another
     triangulation."""
-    from sr33.samplers._repair_kernels import canonical_order, canonical_reorder, delaunay_flips
+    from sr33.samplers._repair_kernels import (
+        canonical_order,
+        canonical_reorder,
+        delaunay_flips,
+        delaunay_flips_since,
+    )
 
     rng = np.random.default_rng(seed)
     g = np.stack(np.meshgrid(np.arange(side), np.arange(side)), -1).reshape(-1, 2).astype(float)
     before = g + rng.uniform(-0.3, 0.3, g.shape)
     inner = ((g > 0) & (g < side - 1)).all(axis=1)  # the hull's points stay
+    inner &= rng.random(inner.size) < share  # (a share of them moves)
     after = before.copy()
     after[inner] += rng.uniform(-move, move, (int(inner.sum()), 2))
     tri, nbr = _canonical_delaunay(before)
     out = delaunay_flips(after, tri, nbr, 1e-9, 1e-10)
     if move <= 0.05:  # no triangle can turn over: flips always do it
         assert out is not None
+    # only the edges with a moved point tested first: the same flips
+    since = delaunay_flips_since(after, before, tri, nbr, 1e-9, 1e-10)
+    assert (since is None) == (out is None)
+    if out is not None:
+        assert since[2] == out[2]
+        np.testing.assert_array_equal(since[0], out[0])
+        np.testing.assert_array_equal(since[1], out[1])
     if out is not None:
         got_t, got_n = canonical_order(out[0], out[1])
         want_t, want_n = _canonical_delaunay(after)
