@@ -1,6 +1,8 @@
-"""numba kernels of a planar face's straight edges (:mod:`sr33.samplers.layers`):
-every point's foot parameter on and distance to every edge, and the clamp
-that keeps free samples inside them.
+"""numba kernels of a planar face's straight edges and arcs
+(:mod:`sr33.samplers.layers`, :mod:`sr33.samplers.chart`): every point's
+foot parameter on and distance to every edge, the projection onto the
+nearest edge or arc, the clamps that keep free samples inside them and the
+ghosts of the faces across them.
 
 The repair calls them at every descent step, on a few hundred samples: as
 numpy expressions they cost more in calls than in arithmetic.  Bit for bit

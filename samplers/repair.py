@@ -216,6 +216,9 @@ class _Problem:
         self._watch: np.ndarray | None = None
         # the last triangulation: (ids, positions, triangles, neighbours), see _delaunay
         self.delaunay: tuple | None = None
+        # the callbacks as :func:`_kernel_form`'s arrays (False: not yet
+        # made; copies share it, their callbacks are the same)
+        self.form: dict | None | bool = False
 
     def watch(self) -> np.ndarray:
         """Samples whose triangles are judged: the movable ones and fixed ones
@@ -484,7 +487,9 @@ def _steps(prob: _Problem, steps: int, subset, active, centres) -> None:
         label = cKDTree(np.asarray(centres)).query(prob.uv)[1].astype(np.int64)
     best, since = np.inf, 0
     movable = prob.free | prob.slide  # the roles stay through a descent
-    form = _kernel_form(prob)
+    if prob.form is False:
+        prob.form = _kernel_form(prob)
+    form = prob.form
     done = 0
     while done < steps:
         if form is not None:  # the steps that need no Qhull, in one kernel
