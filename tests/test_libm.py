@@ -101,3 +101,48 @@ def test_a_sampling_is_the_same_bytes_with_numpys_avx512_loops_off():
     assert out[""][0] == "False"  # numpy's own loops differ here ...
     assert out["AVX512_ICL X86_V4"][0] == "True"  # ... and are the C library's without AVX-512
     assert out[""][1] == out["AVX512_ICL X86_V4"][1]
+
+
+#: numpy functions whose loops differ from the C library's on some processors
+#: (measured on AVX-512, numpy 2.4: the angles, and exp, log, log10, log1p,
+#: expm1, sinh, tanh); sin, cos, sqrt and hypot are the C library's on both
+DISPATCHED = (
+    "arctan2",
+    "arccos",
+    "arcsin",
+    "arctan",
+    "tan",
+    "cbrt",
+    "exp",
+    "expm1",
+    "log",
+    "log10",
+    "log2",
+    "log1p",
+    "sinh",
+    "cosh",
+    "tanh",
+    "power",
+)
+
+
+def test_no_module_takes_a_processor_dependent_function_from_numpy():
+    """Outside numba kernels (which call the C library), the package takes
+    these functions from :mod:`sr33.libm`, never from numpy: a sampling
+    must be the same bytes on every processor."""
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    pattern = re.compile(r"\bnp\.(" + "|".join(DISPATCHED) + r")\(")
+    found = []
+    for folder in ("sr33", "samplers", "validators", "gui"):
+        for path in sorted((root / folder).rglob("*.py")):
+            source = path.read_text()
+            # numba kernels: their numpy calls are numba's, the C library's
+            if path.name == "libm.py" or "@njit" in source:
+                continue
+            for k, line in enumerate(source.splitlines(), 1):
+                if pattern.search(line):
+                    found.append(f"{path.relative_to(root)}:{k}: {line.strip()}")
+    assert not found, "\n".join(found)
