@@ -20,7 +20,16 @@ import numpy as np
 
 from sr33.jit import njit
 
-from ._line_kernels import clamp, clamp_arcs, ghosts, ghosts_arcs, project_curves
+from ._line_kernels import (
+    TWO_PI,
+    clamp,
+    clamp_arcs,
+    clamp_radial,
+    ghosts,
+    ghosts_arcs,
+    inside_sector,
+    project_curves,
+)
 from ._repair_kernels import (
     canonical_reorder,
     centroids,
@@ -32,7 +41,6 @@ from ._repair_kernels import (
     same_points,
 )
 
-TWO_PI = 2 * np.pi
 FINISHED, QHULL, OUT_OF_STEPS = 0, 1, 2  # why :func:`descend` returned
 GHOST, FRAME = -1, -2  # the sample id of a ghost point and of a judged frame point
 
@@ -196,21 +204,6 @@ def _scatter(uv, mask, values):
 
 
 @njit(cache=True)
-def _radial(p, lo, hi):
-    """``chart.RadialClamp``: points moved to a distance from the origin
-    within [lo, hi] (the origin stays)."""
-    out = p.copy()
-    for i in range(p.shape[0]):
-        x, y = p[i, 0], p[i, 1]
-        r = np.sqrt(x * x + y * y)
-        f = min(max(r, lo), hi) / max(r, 1e-300)
-        if r > 0:
-            out[i, 0] = x * f
-            out[i, 1] = y * f
-    return out
-
-
-@njit(cache=True)
 def _inside(c, kind, raster, raster_cell, sector):
     """Which points ``c`` are in the face: by its raster (``kind`` 0,
     ``chart.Raster``) or in an annular sector (1: outer, inner, theta,
@@ -219,15 +212,7 @@ def _inside(c, kind, raster, raster_cell, sector):
         lo, grid = raster
         return grid_lookup(c, lo, raster_cell, grid)
     outer, inner, theta, full = sector
-    out = np.empty(c.shape[0], dtype=np.bool_)
-    for i in range(c.shape[0]):
-        x, y = c[i, 0], c[i, 1]
-        r = np.sqrt(x * x + y * y)
-        ok = r < outer and r > inner
-        if ok and not full:
-            ok = np.arctan2(y, x) % TWO_PI < theta
-        out[i] = ok
-    return out
+    return inside_sector(c, outer, inner, theta, full)
 
 
 @njit(cache=True)
@@ -252,7 +237,7 @@ def _clamped(q, parts, line_clamps, line_margins, arc_clamps):
                 line_margins[k, 1],
             )
         elif parts[k, 0] == 2:
-            q = _radial(q, line_margins[k, 0], line_margins[k, 1])
+            q = clamp_radial(q, line_margins[k, 0], line_margins[k, 1])
         else:
             q = clamp_arcs(
                 q,

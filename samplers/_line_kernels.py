@@ -236,3 +236,34 @@ def ghosts_arcs(p, centre, radius, side, h):
                     out[row, 1] = centre[k, 1] + reach * wy
                     row += 1
     return out
+
+
+@njit(cache=True)
+def clamp_radial(p, lo, hi):
+    """Points moved to a distance from the origin within [lo, hi] (the
+    origin stays; ``chart.RadialClamp``).  Returns a new array."""
+    out = p.copy()
+    for i in range(p.shape[0]):
+        x, y = p[i, 0], p[i, 1]
+        r = np.sqrt(x * x + y * y)
+        f = min(max(r, lo), hi) / max(r, 1e-300)
+        if r > 0:
+            out[i, 0] = x * f
+            out[i, 1] = y * f
+    return out
+
+
+@njit(cache=True)
+def inside_sector(c, outer, inner, theta, full):
+    """Which points ``c`` lie farther than ``inner`` and nearer than
+    ``outer`` from the origin, at an angle in [0, ``theta``) unless
+    ``full`` (``chart.Sector``)."""
+    out = np.empty(c.shape[0], dtype=np.bool_)
+    for i in range(c.shape[0]):
+        x, y = c[i, 0], c[i, 1]
+        r = np.sqrt(x * x + y * y)
+        ok = r < outer and r > inner
+        if ok and not full:
+            ok = np.arctan2(y, x) % TWO_PI < theta
+        out[i] = ok
+    return out

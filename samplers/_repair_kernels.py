@@ -398,6 +398,24 @@ def _flips(pts, tri, nbr, tol_area, tol_circle, moved):
 
 
 @njit(cache=True)
+def _in_order(t2, n2, order):
+    """The rows of ``t2`` (with their neighbours ``n2``) taken in ``order``,
+    the neighbours renumbered to the new rows (-1 stays)."""
+    m = t2.shape[0]
+    back = np.empty(m, dtype=np.int64)
+    for i in range(m):
+        back[order[i]] = i
+    out_t = np.empty_like(t2)
+    out_n = np.empty_like(n2)
+    for i in range(m):
+        for k in range(3):
+            out_t[i, k] = t2[order[i], k]
+            w = n2[order[i], k]
+            out_n[i, k] = back[w] if w >= 0 else -1
+    return out_t, out_n
+
+
+@njit(cache=True)
 def canonical_order(tri, nbr):
     """Counter-clockwise triangles ``tri`` in one order whatever the
     triangulator's: each turned to start at its smallest corner, the rows
@@ -419,17 +437,7 @@ def canonical_order(tri, nbr):
             n2[t, k] = nbr[t, (r + k) % 3]
         key[t] = (t2[t, 0] * big + t2[t, 1]) * big + t2[t, 2]
     order = np.argsort(key)
-    back = np.empty(m, dtype=np.int64)
-    for i in range(m):
-        back[order[i]] = i
-    out_t = np.empty_like(tri)
-    out_n = np.empty_like(nbr)
-    for i in range(m):
-        for k in range(3):
-            out_t[i, k] = t2[order[i], k]
-            w = n2[order[i], k]
-            out_n[i, k] = back[w] if w >= 0 else -1
-    return out_t, out_n
+    return _in_order(t2, n2, order)
 
 
 @njit(cache=True)
@@ -484,17 +492,7 @@ def canonical_reorder(tri, nbr, before):
         else:
             order[o] = kept[j]
             j += 1
-    back = np.empty(m, dtype=np.int64)
-    for i in range(m):
-        back[order[i]] = i
-    out_t = np.empty_like(tri)
-    out_n = np.empty_like(nbr)
-    for i in range(m):
-        for k in range(3):
-            out_t[i, k] = t2[order[i], k]
-            w = n2[order[i], k]
-            out_n[i, k] = back[w] if w >= 0 else -1
-    return out_t, out_n
+    return _in_order(t2, n2, order)
 
 
 @njit(cache=True)

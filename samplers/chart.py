@@ -362,9 +362,7 @@ class RadialClamp:
     hi: float
 
     def __call__(self, p: np.ndarray) -> np.ndarray:
-        r = np.linalg.norm(p, axis=1)
-        s = np.clip(r, self.lo, self.hi) / np.maximum(r, 1e-300)
-        return np.where((r > 0)[:, None], p * s[:, None], p)
+        return line_kernels.clamp_radial(as_points(p), self.lo, self.hi)
 
 
 @dataclass(frozen=True, eq=False)
@@ -379,11 +377,9 @@ class Sector:
     full: bool
 
     def __call__(self, c: np.ndarray) -> np.ndarray:
-        r = np.linalg.norm(c, axis=1)
-        if self.full:
-            return (r < self.outer) & (r > self.inner)
-        a = libm.arctan2(c[:, 1], c[:, 0]) % (2 * math.pi)
-        return (r < self.outer) & (r > self.inner) & (a < self.theta)
+        return line_kernels.inside_sector(
+            as_points(c), float(self.outer), float(self.inner), float(self.theta), bool(self.full)
+        )
 
 
 def segment_distance(p: np.ndarray, seg: np.ndarray, step: float) -> np.ndarray:

@@ -136,24 +136,12 @@ def _arcs(face, to2d, across=()) -> list[Arc]:
 def _project_onto(curves: list, margin: float):
     """Map each point to the nearest point of its nearest curve (arcs and
     lines), at least ``margin`` from the curve's ends."""
-    both = _Curves(curves)
-    edges = both.edges
+    edges = _Edges([c for c in curves if isinstance(c, _Line)])
     # a line's ends are kept ``margin`` away: its parameter within [m, 1 - m]
     m = margin / np.sqrt(edges.dd)
-    if len(both.lines) == len(curves):  # straight edges only: one kernel
+    if edges.a.shape[0] == len(curves):  # straight edges only: one kernel
         return LineProjection(edges.a, edges.d, edges.dd, m)
     return CurveProjection.of_curves(curves, (edges.a, edges.d, edges.dd, m), margin)
-
-
-def _ghosts(arcs: list[Arc], sides: list[float], h: float) -> ArcGhosts:
-    """The neighbouring face unfolded across the arcs: rows h and 2h beyond each arc sample.
-
-    The cylinder (or cone, or sphere) on the other side of a circular edge
-    starts its lattice from the edge's samples, one row about h away from
-    the edge; unfolded into the plane those rows stand beyond the arc
-    (``sides``: +1 where the face is inside the arc's circle, so outwards).
-    """
-    return ArcGhosts.of(arcs, sides, h)
 
 
 def _band_arcs(nbrs, to2d, arcs: list[Arc], sides, s: Samples, h: float, unfold):
@@ -267,26 +255,6 @@ class _Edges:
     def distance(self, p: np.ndarray) -> np.ndarray:
         """(n, m): every point's distance to every edge."""
         return line_kernels.distance(as_points(p), self.a, self.d, self.dd)
-
-
-class _Curves:
-    """Arcs and lines together (in order), the lines' geometry laid out once:
-    the repair asks for distances and nearest curves at every step."""
-
-    def __init__(self, curves: list):
-        self.curves = list(curves)
-        self.lines = [k for k, c in enumerate(self.curves) if isinstance(c, _Line)]
-        self.edges = _Edges([self.curves[k] for k in self.lines])
-
-    def distances(self, p: np.ndarray) -> np.ndarray:
-        """(n, m): every point's distance to every curve."""
-        out = np.empty((p.shape[0], len(self.curves)))
-        if self.lines:
-            out[:, self.lines] = self.edges.distance(p)
-        for k, c in enumerate(self.curves):
-            if not isinstance(c, _Line):
-                out[:, k] = c.distance(p)
-        return out
 
 
 def _slanted(face, row_dir, u: np.ndarray) -> bool:
@@ -658,7 +626,7 @@ def repair_planar_faces(
                 inside=raster,
                 ghosts=_joined(
                     (
-                        [_ghosts(ghosted, [sd for sd, b in zip(sides, banded) if not b], h)]
+                        [ArcGhosts.of(ghosted, [sd for sd, b in zip(sides, banded) if not b], h)]
                         if (ghosted := [a for a, b in zip(arcs, banded) if not b])
                         else []
                     )
@@ -1227,23 +1195,31 @@ def _apex_worst(
     0.984 by its corners, and the check, whose Delaunay triangles there
     are others, 0.851; :func:`lattice_cone_faces` takes both.
     """
+    by_edges, by_corners = _apex_measures(rho, ang, rim_ang, slant, sin_a, t, judged, zone)
+    return by_corners if corners else by_edges
+
+
+def _apex_measures(
+    rho, ang, rim_ang, slant: float, sin_a: float, t: float, judged=None, zone=None
+) -> tuple[float, float]:
+    """:func:`_apex_worst` by the triangles' edges and by their corners'
+    distances, from one intrinsic triangulation."""
     r, tris, lengths, _ = _apex_triangulation(rho, ang, rim_ang, slant, sin_a, t, zone)
     judged = APEX_JUDGED_FROM if judged is None else judged
     inner = r[tris].mean(axis=1) < judged * t if tris.size else np.empty(0, bool)
     if not inner.any():
-        return 0.0
-    if corners:
-        # by the geodesic distances between the corners, the shorter way
-        # round the apex, as the geodesic check measures a triangle's sides
-        _, psi, theta = _apex_zone(rho, ang, rim_ang, slant, sin_a, t, zone)
-        tris = tris[inner]
-        lengths = np.stack(
-            [_shortest(r, psi, theta, tris[:, q], tris[:, (q + 1) % 3]) for q in range(3)], axis=1
-        )
-    else:
-        lengths = lengths[inner]
-    sides = np.sort(lengths, axis=1)
-    return float((sides[:, 1] / sides[:, 2]).max())
+        return 0.0, 0.0
+    # by the geodesic distances between the corners, the shorter way round
+    # the apex, as the geodesic check measures a triangle's sides
+    _, psi, theta = _apex_zone(rho, ang, rim_ang, slant, sin_a, t, zone)
+    tris = tris[inner]
+    apart = np.stack(
+        [_shortest(r, psi, theta, tris[:, q], tris[:, (q + 1) % 3]) for q in range(3)], axis=1
+    )
+    out = []
+    for sides in (np.sort(lengths[inner], axis=1), np.sort(apart, axis=1)):
+        out.append(float((sides[:, 1] / sides[:, 2]).max()))
+    return out[0], out[1]
 
 
 def _cone_rings(plan, reach: int, rim_ang, slant: float, sin_a: float, t: float, inner, limits):
@@ -1361,8 +1337,7 @@ def _rings_judged(got, rim_ang, slant: float, sin_a: float, t: float, inner) -> 
     judged = _developed_worst(got[0], got[1], rim_ang, slant, sin_a, t, inner)
     if inner is not None:
         return judged, judged
-    by_edges = _apex_worst(got[0], got[1], rim_ang, slant, sin_a, t)
-    by_corners = _apex_worst(got[0], got[1], rim_ang, slant, sin_a, t, corners=True)
+    by_edges, by_corners = _apex_measures(got[0], got[1], rim_ang, slant, sin_a, t)
     return max(judged, by_edges, by_corners), max(judged, min(by_edges, by_corners))
 
 

@@ -22,44 +22,30 @@ import numpy as np
 
 from sr33.jit import njit
 
+#: the one-argument functions, by their code in :func:`_unary`
+ACOS, ATAN, TAN, CBRT = 0, 1, 2, 3
+
+
+@njit(cache=True)
+def _unary(op, x):
+    out = np.empty(x.size)
+    for i in range(x.size):
+        if op == ACOS:
+            out[i] = np.arccos(x[i])
+        elif op == ATAN:
+            out[i] = np.arctan(x[i])
+        elif op == TAN:
+            out[i] = np.tan(x[i])
+        else:
+            out[i] = np.cbrt(x[i])
+    return out
+
 
 @njit(cache=True)
 def _atan2(y, x):
     out = np.empty(y.size)
     for i in range(y.size):
         out[i] = np.arctan2(y[i], x[i])
-    return out
-
-
-@njit(cache=True)
-def _acos(x):
-    out = np.empty(x.size)
-    for i in range(x.size):
-        out[i] = np.arccos(x[i])
-    return out
-
-
-@njit(cache=True)
-def _atan(x):
-    out = np.empty(x.size)
-    for i in range(x.size):
-        out[i] = np.arctan(x[i])
-    return out
-
-
-@njit(cache=True)
-def _tan(x):
-    out = np.empty(x.size)
-    for i in range(x.size):
-        out[i] = np.tan(x[i])
-    return out
-
-
-@njit(cache=True)
-def _cbrt(x):
-    out = np.empty(x.size)
-    for i in range(x.size):
-        out[i] = np.cbrt(x[i])
     return out
 
 
@@ -78,22 +64,22 @@ def arctan2(y, x) -> np.ndarray:
 def arccos(x) -> np.ndarray:
     """``np.arccos(x)`` as the C library computes it (see the module)."""
     shape, (xx,) = _flat(x)
-    return _acos(xx).reshape(shape)[()]
+    return _unary(ACOS, xx).reshape(shape)[()]
 
 
 def arctan(x) -> np.ndarray:
     """``np.arctan(x)`` as the C library computes it (see the module)."""
     shape, (xx,) = _flat(x)
-    return _atan(xx).reshape(shape)[()]
+    return _unary(ATAN, xx).reshape(shape)[()]
 
 
 def tan(x) -> np.ndarray:
     """``np.tan(x)`` as the C library computes it (see the module)."""
     shape, (xx,) = _flat(x)
-    return _tan(xx).reshape(shape)[()]
+    return _unary(TAN, xx).reshape(shape)[()]
 
 
 def cbrt(x) -> np.ndarray:
     """``np.cbrt(x)`` as the C library computes it (see the module)."""
     shape, (xx,) = _flat(x)
-    return _cbrt(xx).reshape(shape)[()]
+    return _unary(CBRT, xx).reshape(shape)[()]

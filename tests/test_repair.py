@@ -538,14 +538,10 @@ def slanted_polygon_problem(h: float = 0.05, turn: float = 0.3, hole: bool = Fal
     return uv, free, h, args
 
 
-@pytest.mark.parametrize("turn,hole", [(0.3, False), (1.1, False), (0.7, True)])
-def test_the_descent_in_one_kernel_moves_the_samples_as_the_python_loop(monkeypatch, turn, hole):
-    """A face bounded by straight edges is descended in one numba loop
-    (:mod:`sr33.samplers._descent_kernels`): bit for bit the samples the
-    step-by-step loop gives with the same callbacks as plain functions."""
+def counted_steps(monkeypatch) -> list:
+    """The steps of every call of the fused descent kernel, as they come."""
     import sr33.samplers.repair as rp
 
-    uv, free, h, args = slanted_polygon_problem(turn=turn, hole=hole)
     calls = []
     kernel = rp.descend
 
@@ -555,17 +551,36 @@ def test_the_descent_in_one_kernel_moves_the_samples_as_the_python_loop(monkeypa
         return out
 
     monkeypatch.setattr(rp, "descend", counted)
+    return calls
+
+
+def plain_function(f):
+    """``f`` as a plain function: no data form, so the repair calls it step by step."""
+    return lambda p: f(p)
+
+
+def assert_same_repair(a, b) -> None:
+    assert a.uv.tobytes() == b.uv.tobytes()
+    assert a.origin.tobytes() == b.origin.tobytes()
+    assert (a.bad, a.worst) == (b.bad, b.worst)
+
+
+@pytest.mark.parametrize("turn,hole", [(0.3, False), (1.1, False), (0.7, True)])
+def test_the_descent_in_one_kernel_moves_the_samples_as_the_python_loop(monkeypatch, turn, hole):
+    """A face bounded by straight edges is descended in one numba loop
+    (:mod:`sr33.samplers._descent_kernels`): bit for bit the samples the
+    step-by-step loop gives with the same callbacks as plain functions."""
+    uv, free, h, args = slanted_polygon_problem(turn=turn, hole=hole)
+    calls = counted_steps(monkeypatch)
     fused = repair(uv, free, h, **args)
     assert sum(calls) > 100  # the kernel made the steps
     calls.clear()
     plain = dict(args)
     for name in ("project", "inside", "ghosts", "clamp"):
-        plain[name] = (lambda f: lambda p: f(p))(args[name])
+        plain[name] = plain_function(args[name])
     python = repair(uv, free, h, **plain)
     assert not calls
-    assert fused.uv.tobytes() == python.uv.tobytes()
-    assert fused.origin.tobytes() == python.origin.tobytes()
-    assert (fused.bad, fused.worst) == (python.bad, python.worst)
+    assert_same_repair(fused, python)
 
 
 @pytest.mark.parametrize("theta", [2.0, 2 * np.pi])
@@ -576,7 +591,6 @@ def test_the_descent_in_one_kernel_turns_a_developments_images_as_the_python_loo
     samples wrapped into the sector) and a disk (``theta`` 2 pi, no cut),
     with an annular sector's inside test and a radial clamp: the fused
     descent gives the step-by-step loop's samples bit for bit."""
-    import sr33.samplers.repair as rp
     from sr33.samplers.chart import Sector, radial_clamp
 
     m = 20
@@ -592,21 +606,11 @@ def test_the_descent_in_one_kernel_turns_a_developments_images_as_the_python_loo
         turn=None if full else theta,
     )
     free = (r > 10.5) & (r < 13.5)
-    calls = []
-    kernel = rp.descend
-
-    def counted(*a, **kw):
-        out = kernel(*a, **kw)
-        calls.append(out[1])
-        return out
-
-    monkeypatch.setattr(rp, "descend", counted)
+    calls = counted_steps(monkeypatch)
     fused = repair(uv, free, 1.0, **args)
     assert sum(calls) > 20
     calls.clear()
-    plain = {**args, "inside": (lambda f: lambda p: f(p))(args["inside"])}
+    plain = {**args, "inside": plain_function(args["inside"])}
     python = repair(uv, free, 1.0, **plain)
     assert not calls
-    assert fused.uv.tobytes() == python.uv.tobytes()
-    assert fused.origin.tobytes() == python.origin.tobytes()
-    assert (fused.bad, fused.worst) == (python.bad, python.worst)
+    assert_same_repair(fused, python)
