@@ -990,24 +990,8 @@ def test_a_turned_disk_gets_the_upright_rings(sampled):
     assert disks == _reports(upright, "disk rings")
 
 
-#: stop 60: on the C library's angles (sr33.libm; machines without AVX-512
-#: had them before), the cone turned so keeps the rings of its first end
-#: limits (apex judge 0.8457 by both its measures), and the geodesic check
-#: reads 0.9155 on a triangle of samples 1.8-2.9 t from the apex that is not
-#: Delaunay on the cone: on its development (isometric there; the
-#: circumcircle, radius 0.90 t about a point 2.26 t from the apex, keeps off
-#: it) two samples lie inside its circumcircle.  The check's DT_M keeps a
-#: triangle its flips should have removed: a defect of the check to mend
-#: in the validators, not of the sampling
-TURNED_CONE_APEX = pytest.mark.xfail(
-    strict=True,
-    reason="the geodesic check keeps a non-Delaunay triangle (0.9155) 2 t from the "
-    "turned cone's apex: two samples inside its circumcircle (stop 60, TURNED_CONE_APEX)",
-)
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize("name", [pytest.param("cone", marks=TURNED_CONE_APEX), "cutcube"])
+@pytest.mark.parametrize("name", ["cone", "cutcube"])
 def test_turned_rims_disks_and_scoops_meet_condition_iii(sampled, name):
     """Turned by (4.3, 162.2, -128.1) degrees: the cone's disk keeps the
     upright's rings (0.872 before), and cutcube's hole keeps its lattice:
@@ -1015,7 +999,11 @@ def test_turned_rims_disks_and_scoops_meet_condition_iii(sampled, name):
     and a rim sample a repair added counts as the rim's (the two rims of
     the hole once parted, the wall kept its scan rows: 0.998), its scoop
     repaired again from 0.835 on its map (0.849 there was 0.858 on the
-    sphere)."""
+    sphere).  The cone read 0.9155 by the check, 2 t from its apex, on a
+    triangle that is not Delaunay on the cone (two samples inside its
+    circumcircle on the development): the check had counted the bumps its
+    inserted samples raise on the truth's chords as curvature, and kept
+    the labels' diagonal (stop 61; 0.8455 now)."""
     pytest.importorskip("potpourri3d")
     from sr33.validators.conditions import sample_conditions
 

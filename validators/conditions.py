@@ -672,7 +672,20 @@ def _cell_curvature(tv, tf, label, snap, n: int) -> np.ndarray:
     corner sampled there: every triangle at it stays flat).  On the
     piecewise-flat truth the curvature sits at its vertices, so a quad of
     DT_M triangles whose four cells hold none is flat: its developed angles
-    are exact."""
+    are exact.
+
+    ``tv``, ``tf`` are the truth refined *before* the samples were inserted
+    (``label`` runs over the vertices after, which keep the first ones'
+    numbers; the inserted ones count none).  A sample lies on the true
+    surface, a little off the truth's chord triangles, so inserting it at
+    its place raises a small bump: positive curvature at the sample and as
+    much negative round it, an artefact of the tessellation and not the
+    truth's.  Counted, it made a flat cone's quad near its apex read 2.9°
+    of curvature (a cone turned by (4.26, 162.17, -128.10): the bump of one
+    sample 0.084 rad, its ring -0.076), which kept a triangle 0.79° from
+    Delaunay that the development shows is not (two samples inside its
+    circumcircle), read 0.9155.
+    """
     corner = tv[tf]
     ang = np.stack(
         [
@@ -689,7 +702,8 @@ def _cell_curvature(tv, tf, label, snap, n: int) -> np.ndarray:
     inc = edge_incidence(*half_edges(tf))
     boundary = np.zeros(tv.shape[0], dtype=bool)
     boundary[inc.edges[inc.counts == 1].ravel()] = True
-    defect = np.where(boundary, 0.0, np.abs(2 * np.pi - total))
+    defect = np.zeros(label.shape[0])
+    defect[: tv.shape[0]] = np.where(boundary, 0.0, np.abs(2 * np.pi - total))
     defect[snap] = 0.0
     ok = label >= 0
     return np.bincount(label[ok], weights=defect[ok], minlength=n)
@@ -1025,6 +1039,7 @@ def sample_conditions(
     with timed("conditions: truth refined"):
         local = _LocalResolution(tree, nn[:, 1], resolution)
         tv, tf = refine_to_edge_length(ov, of, resolution, local=local)
+        refined = (tv, tf)  # before the samples are inserted: the truth's curvature
         try:
             tv, tf, snap = insert_points(tv, tf, pts)
         except ValueError as exc:
@@ -1049,7 +1064,7 @@ def sample_conditions(
         geodesics(dt_edges)  # every DT_M edge's length, in one pass
     if flip_ties:
         with timed("conditions: angle test"):
-            curvature = _cell_curvature(tv, tf, label, snap, n)
+            curvature = _cell_curvature(*refined, label, snap, n)
             dt_edges, crossings, dt_tri = _flip_to_delaunay(
                 pts, (dt_edges, crossings, dt_tri), geodesics, curvature=curvature
             )
