@@ -66,3 +66,23 @@ class EdgeFaces:
         return [
             [(e, self.other(e, fi)) for e in face.Edges()] for fi, face in enumerate(self.faces)
         ]
+
+    def folded(self, degrees: float) -> set[tuple[int, int]]:
+        """Pairs of faces (both orders) that meet along an edge where the
+        surface folds back sharper than ``degrees``: their normals at the
+        edge's middle more than ``180 - degrees`` apart (an acute edge, or
+        a narrow slot's reflex one).  Near such an edge the two faces'
+        points are near in space and far on the surface."""
+        import numpy as np
+
+        limit = np.cos(np.radians(180.0 - degrees))
+        out: set[tuple[int, int]] = set()
+        for edge, fids in zip(self.edges, self.faces_of):
+            if len(fids) != 2:
+                continue
+            mid = edge.positionAt(0.5, mode="length")
+            n1 = np.array(self.faces[fids[0]].normalAt(mid).toTuple())
+            n2 = np.array(self.faces[fids[1]].normalAt(mid).toTuple())
+            if float(np.dot(n1, n2)) < limit:
+                out |= {(fids[0], fids[1]), (fids[1], fids[0])}
+        return out

@@ -93,6 +93,12 @@ from .frame import in_frame, model_frame
 AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 EDGE_STEP = 1.0  # spacing of corner/edge samples, times h
 FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times h
+#: the scan-line samples of two faces that meet where the surface folds back
+#: sharper than ``FOLDED`` degrees (an acute edge, a narrow slot) are thinned
+#: only this near each other (times h; any others at half a spacing): there
+#: they are near in space and far on the surface
+ACROSS = 0.3
+FOLDED = 60.0
 CLOSEST = 0.25  # no two samples nearer than this, times h (the sampler's contract)
 FILL_RADIUS = 1.0  # gaps wider than this (times h) get extra samples
 #: a strip narrower than this (times its leading edge's step) is sampled
@@ -1202,7 +1208,10 @@ def scan(
         alive = np.flatnonzero(
             _drop_near_features(allp, on_line, feature_curve, FEATURE_CLEARANCE * h)
         )
-        keep = alive[thin(allp[alive], 0.5 * min(1.0, ratio) * h)]
+        own = np.where(on_line, np.array(fids, dtype=np.int64), -1)
+        radius = 0.5 * min(1.0, ratio) * h
+        folded = EdgeFaces(occ).folded(FOLDED)
+        keep = alive[thin(allp[alive], radius, own[alive], min(ACROSS * h, radius), folded)]
         points = allp[keep]
         line_id = np.array(line_ids, dtype=np.int64)[keep]
         face_id = np.array(fids, dtype=np.int64)[keep]

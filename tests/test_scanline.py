@@ -235,3 +235,56 @@ def test_a_boxs_side_rows_meet_its_vertical_edges_samples_whatever_stands_on_it(
     q = (p[side, 2] + 0.6) * m / 0.6
     assert side.sum() > 500
     assert np.abs(q - np.round(q)).max() < 1e-6
+
+
+def test_thinning_keeps_two_faces_samples_that_stand_near_across_a_fold():
+    """Points of two faces that meet along a fold (an acute edge) are
+    thinned against each other only within ``across``; any others (one
+    face, a shared edge's samples, label -1, faces across a tangent seam)
+    within the radius."""
+    from sr33.samplers.faces import thin
+
+    pts = np.array([[0.0, 0, 0], [0.43, 0, 0], [0.0, 0.2, 0], [1.0, 0, 0], [1.2, 0, 0]])
+    labels = np.array([0, 1, 1, -1, 0])
+    folded = {(0, 1), (1, 0)}
+    assert thin(pts, 0.5).tolist() == [0, 3]
+    # 1 stays (the folded face, 0.43 away), 2 goes (0.2 from 0, within
+    # across), 4 goes (0.2 from the edge's sample 3)
+    assert thin(pts, 0.5, labels, 0.3, folded).tolist() == [0, 1, 3]
+    assert thin(pts, 0.5, labels, 0.3).tolist() == [0, 3]  # no fold: as before
+
+
+def test_the_faces_of_an_acute_edge_keep_their_first_rows():
+    """A prism over an isosceles triangle of 25°: the rows of its two
+    sides 1 h off the apex edge stand 2 sin(12.5°) h = 0.43 h apart, and
+    thinning them at half a spacing left one side's first row 2 h off the
+    edge (54 samples breaking Condition III-ii along it, worst 0.896).
+    Now both sides keep a row within 1.3 h, and no sample of the edge's
+    middle (3 h or more from its ends, where the caps' acute corners are)
+    breaks III-ii."""
+    pytest.importorskip("potpourri3d")
+    from sr33.samplers import shapes
+    from sr33.samplers.scanline import ACROSS
+    from sr33.validators.conditions import sample_conditions
+
+    t = np.tan(np.radians(12.5))
+    solid = cq.Workplane("XY").polyline([(0, 0), (1.0, -t), (1.0, t)]).close().extrude(0.5).val()
+    shape = shapes.from_cad(solid, name="25° prism")
+    r = scan(shape, target_points=3000)
+    h = r.meta["spacing"]
+    p = r.points
+    off_edge = np.hypot(p[:, 0], p[:, 1])  # the apex edge is the z axis
+    # the two sides that meet at the apex edge (the caps lie in z = 0, 0.5)
+    sides = [
+        f
+        for f in np.unique(r.face_id)
+        if np.ptp(p[r.face_id == f, 2]) > 0.4 and off_edge[r.face_id == f].min() < 3 * h
+    ]
+    assert len(sides) == 2
+    for f in sides:
+        rows = (r.face_id == f) & (r.line_id >= 0)
+        assert off_edge[rows].min() < 1.3 * h
+    assert cKDTree(p).query(p, 2)[0][:, 1].min() >= ACROSS * h - 1e-12
+    w = sample_conditions(p, shape.truth_vertices, shape.truth_triangles).worst_ratio
+    middle = (off_edge < 3 * h) & (p[:, 2] > 3 * h) & (p[:, 2] < 0.5 - 3 * h)
+    assert middle.sum() > 20 and np.nanmax(w[middle]) < 0.85
