@@ -8,6 +8,8 @@ the functions run.
 
 from __future__ import annotations
 
+import numpy as np
+
 
 def face_index(face, faces) -> int:
     """Index of ``face`` in ``faces`` (same TShape and location), -1 if absent."""
@@ -73,8 +75,6 @@ class EdgeFaces:
         edge's middle more than ``180 - degrees`` apart (an acute edge, or
         a narrow slot's reflex one).  Near such an edge the two faces'
         points are near in space and far on the surface."""
-        import numpy as np
-
         limit = np.cos(np.radians(180.0 - degrees))
         out: set[tuple[int, int]] = set()
         for edge, fids in zip(self.edges, self.faces_of):
