@@ -65,14 +65,17 @@ lock: $(STAMP)
 # class (1,000 models: hours); one file alone: make fuzz FUZZ=tests/test_fuzz.py;
 # a survey of the generated models (no shrinking, failures listed with their
 # recipes, every class's shares): make fuzz FUZZ=tests/test_generated.py
-# FUZZ_SURVEY=1 GENERATED_PER_CLASS=4
+# FUZZ_SURVEY=1 GENERATED_PER_CLASS=4; FUZZ_SEED=N draws the same models
+# again (a survey before and after a change, on the same models)
 FUZZ ?= tests/test_fuzz.py tests/test_properties.py tests/test_generated.py
 FUZZ_SURVEY ?= 0
 GENERATED_PER_CLASS ?= 125
+FUZZ_SEED ?=
 fuzz: $(STAMP)
 	HYPOTHESIS_PROFILE=deep FUZZ_REPORT=1 FUZZ_SURVEY=$(FUZZ_SURVEY) \
 	GENERATED_PER_CLASS=$(GENERATED_PER_CLASS) \
-	$(BIN)/python -m pytest -q -p no:cacheprovider $(FUZZ)
+	$(BIN)/python -m pytest -q -p no:cacheprovider \
+	$(if $(FUZZ_SEED),--hypothesis-seed=$(FUZZ_SEED)) $(FUZZ)
 
 # the optional comparison (Open3D ball pivoting and Poisson, CGAL advancing
 # front); Open3D's wheel needs the system library libusb-1.0
