@@ -50,6 +50,7 @@ class EdgeFaces:
                     uniq.append(k)
             self.faces_of.append(uniq)
             self.uses.append(len(adj))
+        self._bends: dict[int, float | None] = {}
 
     def index(self, edge) -> int:
         """Position of ``edge`` in :attr:`edges` (-1 if it bounds no face)."""
@@ -69,20 +70,31 @@ class EdgeFaces:
             [(e, self.other(e, fi)) for e in face.Edges()] for fi, face in enumerate(self.faces)
         ]
 
+    def bend(self, k: int) -> float | None:
+        """The cosine between the normals of the two faces of edge ``k`` at
+        its middle (1: the surface goes on flat across it; -1: it folds
+        right back), None unless it bounds two faces; computed once."""
+        if k not in self._bends:
+            fids = self.faces_of[k]
+            out = None
+            if len(fids) == 2:
+                mid = self.edges[k].positionAt(0.5, mode="length")
+                n1 = np.array(self.faces[fids[0]].normalAt(mid).toTuple())
+                n2 = np.array(self.faces[fids[1]].normalAt(mid).toTuple())
+                out = float(np.dot(n1, n2))
+            self._bends[k] = out
+        return self._bends[k]
+
     def folded(self, degrees: float) -> set[tuple[int, int]]:
         """Pairs of faces (both orders) that meet along an edge where the
         surface folds back sharper than ``degrees``: their normals at the
-        edge's middle more than ``180 - degrees`` apart (an acute edge, or
-        a narrow slot's reflex one).  Near such an edge the two faces'
-        points are near in space and far on the surface."""
+        edge's middle more than ``180 - degrees`` apart (:meth:`bend`; an
+        acute edge, or a narrow slot's reflex one).  Near such an edge the
+        two faces' points are near in space and far on the surface."""
         limit = np.cos(np.radians(180.0 - degrees))
         out: set[tuple[int, int]] = set()
-        for edge, fids in zip(self.edges, self.faces_of):
-            if len(fids) != 2:
-                continue
-            mid = edge.positionAt(0.5, mode="length")
-            n1 = np.array(self.faces[fids[0]].normalAt(mid).toTuple())
-            n2 = np.array(self.faces[fids[1]].normalAt(mid).toTuple())
-            if float(np.dot(n1, n2)) < limit:
+        for k, fids in enumerate(self.faces_of):
+            bend = self.bend(k)
+            if bend is not None and bend < limit:
                 out |= {(fids[0], fids[1]), (fids[1], fids[0])}
         return out

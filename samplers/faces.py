@@ -87,6 +87,7 @@ def thin(
     for i in range(points.shape[0]):
         kx, ky, kz = keys[i]
         p = points[i]
+        pair = int(labels[i]) if labels is not None and folded else None
         ok = True
         for dx in (-1, 0, 1):
             for dy in (-1, 0, 1):
@@ -94,10 +95,9 @@ def thin(
                     for j in grid.get((kx + dx, ky + dy, kz + dz), ()):
                         q = points[j]
                         d2 = (p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 + (p[2] - q[2]) ** 2
-                        if d2 < (
-                            a2
-                            if labels is not None and (int(labels[i]), int(labels[j])) in folded
-                            else r2
+                        # between across and radius: dropped unless the faces fold apart
+                        if d2 < a2 or (
+                            d2 < r2 and (pair is None or (pair, int(labels[j])) not in folded)
                         ):
                             ok = False
                             break

@@ -56,8 +56,9 @@ from sr33.progress import log
 from ._descent_kernels import QHULL, descend
 from ._repair_kernels import (
     canonical_order,
+    canonical_reorder,
     centroids,
-    delaunay_flips,
+    delaunay_flips_since,
     descent_step,
     energy_terms,
     gathered_gradient,
@@ -346,7 +347,7 @@ def _delaunay(prob: _Problem, pts: np.ndarray, of: np.ndarray) -> np.ndarray:
     triangles: when the points are the same ones as at the problem's last
     triangulation (the same ids, none moved more than ``KEEP_MOVE`` h since)
     its triangles are mended by Lawson's edge flips
-    (:func:`sr33.samplers._repair_kernels.delaunay_flips`), which give the
+    (:func:`sr33.samplers._repair_kernels.delaunay_flips_since`), which give the
     Delaunay triangles while every triangle is still counter-clockwise and
     they tile the hull once; else Qhull triangulates anew.  Where four
     points are cocircular within rounding (a lattice's squares) either
@@ -357,11 +358,13 @@ def _delaunay(prob: _Problem, pts: np.ndarray, of: np.ndarray) -> np.ndarray:
     h = prob.h
     last = prob.delaunay
     if last is not None and same_points(last[0], of, last[1], pts, KEEP_MOVE * h):
-        flipped = delaunay_flips(pts, last[2], last[3], KEEP_AREA * h * h, KEEP_CIRCLE * h**4)
+        flipped = delaunay_flips_since(
+            pts, last[1], last[2], last[3], KEEP_AREA * h * h, KEEP_CIRCLE * h**4
+        )
         if flipped is not None:
             tri, nbr, flips = flipped
             if flips:
-                tri, nbr = canonical_order(tri, nbr)
+                tri, nbr = canonical_reorder(tri, nbr, last[2])
             prob.delaunay = (last[0], pts, tri, nbr)
             return tri
     try:

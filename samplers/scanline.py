@@ -809,7 +809,14 @@ def _square_crossings(a, u, length, adjacent, faces, polygonal, planes, axes, st
 
 
 def _feature_samples(
-    occ, step: float, sharp_degrees: float, tol: float, planes=None, axes=None, banded=frozenset()
+    occ,
+    step: float,
+    sharp_degrees: float,
+    tol: float,
+    planes=None,
+    axes=None,
+    banded=frozenset(),
+    ef: EdgeFaces | None = None,
 ):
     """Samples on B-rep vertices and on sharp or boundary edges.
 
@@ -828,7 +835,7 @@ def _feature_samples(
     listed edge by edge in the shape's edge order, whatever order the edges
     were sampled in.
     """
-    ef = EdgeFaces(occ)
+    ef = EdgeFaces(occ) if ef is None else ef
     faces = ef.faces
     pts: list[np.ndarray] = []
     fid: list[int] = []
@@ -849,10 +856,7 @@ def _feature_samples(
         uniq = [faces[k] for k in fids]
         first = fids[0] if fids else -1
         if len(uniq) == 2:
-            mid = edge.positionAt(0.5, mode="length")
-            n1 = np.array(uniq[0].normalAt(mid).toTuple())
-            n2 = np.array(uniq[1].normalAt(mid).toTuple())
-            if float(dot(n1, n2)) > cos_lim:
+            if ef.bend(ei) > cos_lim:
                 continue  # smooth edge (fillet tangency) or seam: sampled by scan lines
         elif len(uniq) != 1 or uses != 1:
             continue  # a seam edge (one face on both sides): sampled by scan lines
@@ -1163,6 +1167,7 @@ def scan(
             planes.append((d, t0, hf, _columns(face, d, hf, ratio, *columns[fi])))
         with timed("sample: feature samples"):
             chains = developable_bands(occ, size, sharp_degrees)
+            edge_faces = EdgeFaces(occ)
             pts, fids, feature_curve, lattices = _feature_samples(
                 occ,
                 EDGE_STEP * h,
@@ -1171,6 +1176,7 @@ def scan(
                 planes,
                 columns,
                 {f for band in chains for f in band.faces},
+                edge_faces,
             )
         pbar.update(1)
         n_feature = len(pts)
@@ -1210,7 +1216,7 @@ def scan(
         )
         own = np.where(on_line, np.array(fids, dtype=np.int64), -1)
         radius = 0.5 * min(1.0, ratio) * h
-        folded = EdgeFaces(occ).folded(FOLDED)
+        folded = edge_faces.folded(FOLDED)
         keep = alive[thin(allp[alive], radius, own[alive], min(ACROSS * h, radius), folded)]
         points = allp[keep]
         line_id = np.array(line_ids, dtype=np.int64)[keep]
