@@ -75,6 +75,7 @@ from .repair import (
     MOVABLE,
     RETRY_BAD,
     Repaired,
+    anneal_corners,
     copies,
     glued,
     repair,
@@ -736,7 +737,10 @@ def unstuck(
     worst bought with more bad triangles trades the chart's margin, not
     the surface's: conebox's top went from 0.859 with 2 to 0.850 with 5 in
     its chart, and to 0.979 by the geodesic check (its rim's ghost rows are
-    not where the cone's rings will be).  ``kwargs`` are the repair's own.
+    not where the cone's rings will be).  Last, still stuck, its acute
+    corners between straight edges are annealed
+    (:func:`sr33.samplers.repair.anneal_corners`).  ``kwargs`` are the
+    repair's own.
 
     The repair is a local search whose end hangs on its path: cutcube's
     face where the scoop's arc meets the cube's edge ended at 0.829 or at
@@ -763,6 +767,8 @@ def unstuck(
         )
         if shaken.worst < r.worst and shaken.bad <= r.bad:
             r = shaken
+    if r.worst >= stuck:
+        r = anneal_corners(uv, free, h, r, **kwargs)  # r itself unless it beats it
     return r
 
 

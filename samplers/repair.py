@@ -33,11 +33,17 @@ Delaunay triangle meets the condition with a margin:
 * :func:`split_corners`, for a face left with a few bad triangles at a
   fixed corner: a sample added on the corner's bisector, and the repair
   run again.
+* :func:`anneal_corners`, for a face left stuck near a corner below
+  ``ACUTE`` degrees between two straight edges: the corner's samples
+  annealed, seeded (:mod:`sr33.samplers._anneal_kernels`).
 
 The domain is 2-D (a planar face in plane coordinates).  Everything is
-numpy and scipy's Delaunay, with the energy, its gradient and the edge
-flips in numba kernels (:mod:`sr33.samplers._repair_kernels`, the energy bit
-for bit the numpy code it replaced); no randomness.
+numpy, with the Delaunay triangulation
+(:mod:`sr33.samplers._delaunay_kernels`; Qhull where it gives up), the
+energy, its gradient and the edge flips in numba kernels
+(:mod:`sr33.samplers._repair_kernels`, the energy bit for bit the numpy
+code it replaced); its only random numbers are seeded (the shakes, the
+annealing), the same on every machine.
 """
 
 from __future__ import annotations
@@ -53,6 +59,7 @@ from sr33 import libm
 from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
 
+from ._anneal_kernels import FIXED, FREE, ON_EDGE, anneal_corner, corner_score
 from ._delaunay_kernels import delaunay_triangles
 from ._descent_kernels import QHULL, descend
 from ._repair_kernels import (
@@ -93,6 +100,13 @@ CORNER_DISTANCES = (0.7, 0.85, 1.0)  # a sample added on a corner's bisector thi
 CORNER_ROUNDS = 4  # corners split one after another, at most this many
 CORNER_REACH = 4.0  # a split's repair moves the free samples this near (times h) the new one
 WATCH_GONE = 1.5  # ... and is judged on the samples this near (times h) free ones it removed
+ACUTE = 75.0  # corners between two straight edges below this (degrees) are annealed when stuck
+ANNEAL_REACH = 4.5  # ... their samples this near the corner (times h) moving
+ANNEAL_CLEAR = 0.4  # ... free ones at least this far (times h) inside both edges
+ANNEAL_RESTARTS = 3  # ... in this many seeded runs
+ANNEAL_MOVES = 4000  # ... of this many moves
+ANNEAL_SIGMA = 0.08  # ... each a normal step of this (times h)
+ANNEAL_T0 = 0.02  # ... at a temperature falling from this to a thousandth of it
 GOOD_ENOUGH = 0.85  # further attempts (after a first one broke III-ii) end below this
 # ... and with at least this many triangles above the margin: a few in the
 # chart's judged frame are often no violation on the surface, and retrying
@@ -1192,4 +1206,186 @@ def split_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
         added = out.uv.shape[0]  # the index of the sample this round added
         origin = np.r_[out.origin, -1][np.where(trial.origin >= 0, trial.origin, added)]
         out = Repaired(uv=trial.uv, origin=origin, bad=judged.bad, worst=judged.worst)
+    return out
+
+
+def _acute_corners(uv: np.ndarray, slide: np.ndarray, anchors: np.ndarray, h: float):
+    """The anchors of ``uv`` where two straight runs of sliding samples meet
+    at less than ``ACUTE`` degrees, each with the unit directions of its two
+    runs: every sliding sample within ``ANNEAL_REACH + 3`` h of the anchor
+    lies on one of two rays from it (within ``1e-6`` h), else the corner is
+    not taken (a curved edge, a third edge near)."""
+    found = []
+    rim = np.flatnonzero(slide | anchors)
+    if rim.size < 3:
+        return found
+    tree = cKDTree(uv[rim])
+    for a in np.flatnonzero(anchors):
+        near = rim[tree.query_ball_point(uv[a], (ANNEAL_REACH + 3.0) * h)]
+        near = near[(near != a) & slide[near]]
+        if near.size < 2:
+            continue
+        vec = uv[near] - uv[a]
+        dist = np.hypot(vec[:, 0], vec[:, 1])
+        order = np.lexsort((vec[:, 1], vec[:, 0], dist))
+        rays: list[np.ndarray] = []
+        for k in order:
+            u = vec[k] / dist[k]
+            on = [
+                r for r in rays if abs(u[0] * r[1] - u[1] * r[0]) * dist[k] < 1e-6 * h and u @ r > 0
+            ]
+            if not on:
+                rays.append(u)
+        if len(rays) != 2:
+            continue
+        angle = math.degrees(math.acos(max(-1.0, min(1.0, float(rays[0] @ rays[1])))))
+        if angle < ACUTE:
+            found.append((int(a), np.array(rays)))
+    return found
+
+
+def anneal_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
+    """Anneal the samples round a planar face's acute corners left with a bad triangle.
+
+    Round a corner below ``ACUTE`` degrees between two straight edges, the
+    two edges' samples must stagger near the corner (a triangle of two
+    samples at one distance on the two edges has two equal long sides:
+    ratio 1), then stand side by side where the face is as wide as the
+    spacing, then let a free sample in on the bisector.  The descent of
+    :func:`repair` does not reorder them: a 30° wedge's end cap ended at
+    0.883 from 40 shaken starts of 41.  Here the free samples within
+    ``ANNEAL_REACH`` h of the corner, and the edges' samples there (along
+    their edges, in their order), are annealed
+    (:func:`sr33.samplers._anneal_kernels.anneal_corner`: ``ANNEAL_RESTARTS``
+    seeded runs of ``ANNEAL_MOVES`` moves), scored by the worst ratio of
+    the corner's Delaunay triangles with the repair's penalties (short
+    edges, wide circles, an edge's gaps outside ``GAP``; the gap between
+    samples of the two edges is free there, unlike in the descent).  The
+    best run's points replace the answer's when the whole face, judged
+    like ``first``, has a lower worst ratio and either no more bad
+    triangles or none at or above ``GOOD_ENOUGH`` (every triangle of a
+    corner between straight edges is judged exactly).
+    Corners are taken where a triangle above ``BAD`` has a corner within
+    ``ANNEAL_REACH`` h of theirs, in the order of their samples.
+
+    Parameters
+    ----------
+    uv, free, h
+        The input of ``first``'s :func:`repair`.
+    first : Repaired
+        Its answer.
+    **kwargs
+        The keyword arguments of that repair (``slide``, ``anchors``,
+        ``inside``, ...), passed on to the judging one.
+
+    Returns
+    -------
+    Repaired
+        ``first``, or a better answer whose ``origin`` refers to ``uv``.
+    """
+    uv = np.asarray(uv, dtype=np.float64)
+    n = uv.shape[0]
+    free = np.asarray(free, dtype=bool)
+    slide = kwargs.pop("slide", None)
+    slide = np.zeros(n, dtype=bool) if slide is None else np.asarray(slide, dtype=bool)
+    anchors = kwargs.pop("anchors", None)
+    if anchors is None or first.worst <= BAD or kwargs.get("turn") is not None:
+        return first
+    anchors = np.asarray(anchors, dtype=bool)
+    inside = kwargs.get("inside") or (lambda c: np.ones(c.shape[0], dtype=bool))
+    judge_kw = {k: v for k, v in kwargs.items() if k not in ("descent_steps", "max_edits")}
+    judge_kw.update(descent_steps=0, max_edits=0)
+    out = first
+    was = np.where(out.origin >= 0, out.origin, n)
+    sliding = np.r_[slide & ~anchors, False][was]
+    anchored = np.r_[anchors, False][was]
+    corners = _acute_corners(out.uv, sliding, anchored, h)
+    if not corners:
+        return first
+    for a, rays in corners:
+        if out.worst <= BAD:
+            break
+        try:
+            tri = Delaunay(out.uv).simplices
+        except QhullError:
+            break
+        tri = tri[inside(out.uv[tri].mean(axis=1))]
+        bad = tri[triangle_ratios(out.uv, tri) > BAD]
+        apex = out.uv[a]
+        if (
+            not bad.size
+            or np.linalg.norm(out.uv[bad.ravel()] - apex, axis=1).min() > ANNEAL_REACH * h
+        ):
+            continue
+        was = np.where(out.origin >= 0, out.origin, n)
+        movable_free = np.r_[free, True][was]
+        sliding = np.r_[slide & ~anchors, False][was]
+        dist = np.linalg.norm(out.uv - apex, axis=1)
+        local = np.flatnonzero(dist < (ANNEAL_REACH + 3.0) * h)
+        local = local[np.lexsort((out.uv[local, 1], out.uv[local, 0]))]
+        rel = out.uv[local] - apex
+        cross = np.abs(rel[:, None, 0] * rays[None, :, 1] - rel[:, None, 1] * rays[None, :, 0])
+        ahead = rel @ rays.T > 0
+        on = (cross < 1e-6 * h) & ahead & (sliding | np.r_[anchors, False][was])[local, None]
+        edge = np.where(on[:, 0], 0, np.where(on[:, 1], 1, -1))
+        edge[local == a] = 2
+        reach = dist[local] < ANNEAL_REACH * h
+        kind = np.full(local.size, FIXED, dtype=np.int64)
+        kind[reach & movable_free[local]] = FREE
+        kind[reach & sliding[local] & (edge >= 0) & (edge < 2)] = ON_EDGE
+        if not (kind != FIXED).any():
+            continue
+        turn = rays[0, 0] * rays[1, 1] - rays[0, 1] * rays[1, 0]
+        normals = np.array([[-rays[0, 1], rays[0, 0]], [rays[1, 1], -rays[1, 0]]])
+        normals *= 1.0 if turn > 0 else -1.0
+        pts = np.ascontiguousarray(out.uv[local])
+        geom = (
+            edge.astype(np.int64),
+            np.ascontiguousarray(apex),
+            np.ascontiguousarray(rays),
+            normals,
+        )
+        judged_within = (ANNEAL_REACH + 1.2) * h
+        bounds = (h, GAP[0], GAP[1], SHORT, WIDE)
+        start = corner_score(pts, *geom, judged_within, *bounds)[0]
+        best, best_score = pts, start
+        for seed in range(ANNEAL_RESTARTS):
+            p, score = anneal_corner(
+                pts,
+                kind,
+                *geom,
+                ANNEAL_REACH * h,
+                judged_within,
+                ANNEAL_CLEAR,
+                *bounds,
+                seed,
+                ANNEAL_MOVES,
+                ANNEAL_SIGMA,
+                ANNEAL_T0,
+            )
+            if score < best_score:
+                best, best_score = p, score
+        if best_score >= start:
+            continue
+        trial_uv = out.uv.copy()
+        trial_uv[local] = best
+        src = was
+        watch = np.r_[free, True][src]
+        judged = repair(
+            trial_uv,
+            watch,
+            h,
+            slide=np.r_[slide, False][src],
+            anchors=np.r_[anchors, False][src],
+            **judge_kw,
+        )
+        log.debug(
+            "corner annealed: %.4f (%d bad) against %.4f (%d bad)",
+            judged.worst,
+            judged.bad,
+            out.worst,
+            out.bad,
+        )
+        if judged.worst < out.worst and (judged.bad <= out.bad or judged.worst < GOOD_ENOUGH):
+            out = Repaired(uv=trial_uv, origin=out.origin, bad=judged.bad, worst=judged.worst)
     return out

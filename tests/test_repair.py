@@ -6,7 +6,16 @@ import numpy as np
 import pytest
 from scipy.spatial import Delaunay, cKDTree
 
-from sr33.samplers.repair import BAD, repair, rotate, split_corners
+from sr33.samplers._anneal_kernels import corner_score
+from sr33.samplers.repair import (
+    ANNEAL_REACH,
+    BAD,
+    SHORT,
+    anneal_corners,
+    repair,
+    rotate,
+    split_corners,
+)
 
 
 def hole_layout(h, radius, centre):
@@ -614,3 +623,110 @@ def test_the_descent_in_one_kernel_turns_a_developments_images_as_the_python_loo
     python = repair(uv, free, 1.0, **plain)
     assert not calls
     assert_same_repair(fused, python)
+
+
+def _acute_triangle(degrees: float, length: float):
+    """An isosceles triangle with its apex of ``degrees`` at the origin and its
+    base at x = ``length``, laid out as the scan lays a face: its edges
+    sampled h = 1 apart and sliding, its corners anchored, rows of a square
+    lattice kept 0.6 h inside the edges free."""
+    half = np.radians(degrees / 2)
+    corners = np.array(
+        [(0.0, 0.0), (length, -length * np.tan(half)), (length, length * np.tan(half))]
+    )
+    sides = list(zip(corners, np.roll(corners, -1, axis=0)))
+    inward = np.array([(-(q - p)[1], (q - p)[0]) / np.linalg.norm(q - p) for p, q in sides])
+
+    def inside(q):
+        return np.all([(q - p) @ nrm > -1e-9 for (p, _), nrm in zip(sides, inward)], axis=0)
+
+    def project(q):
+        feet = []
+        for p, r in sides:
+            d = r - p
+            t = np.clip(((q - p) @ d) / (d @ d), 0.0, 1.0)
+            feet.append(p + t[:, None] * d)
+        feet = np.stack(feet, 1)
+        return feet[np.arange(len(q)), np.linalg.norm(q[:, None] - feet, axis=2).argmin(axis=1)]
+
+    edge = []
+    for p, r in sides:
+        m = int(round(np.linalg.norm(r - p)))
+        edge += [p + (r - p) * k / m for k in range(1, m)]
+    g = np.array(
+        [(x, y) for x in np.arange(0.5, length, 1.0) for y in np.arange(-x, x + 1e-9, 1.0)]
+    )
+    g = g[np.all([(g - p) @ nrm > 0.6 for (p, _), nrm in zip(sides, inward)], axis=0)]
+    uv = np.vstack([corners, edge, g])
+    n_fixed = 3 + len(edge)
+    slide = np.r_[np.zeros(3, bool), np.ones(len(edge), bool), np.zeros(len(g), bool)]
+    anchors = np.r_[np.ones(3, bool), np.zeros(len(uv) - 3, bool)]
+    free = np.r_[np.zeros(n_fixed, bool), np.ones(len(g), bool)]
+    return uv, free, dict(slide=slide, project=project, anchors=anchors, inside=inside)
+
+
+def _near_apex_worst(uv, inside, reach):
+    tri = Delaunay(uv).simplices
+    tri = tri[inside(uv[tri].mean(axis=1))]
+    near = (np.linalg.norm(uv[tri], axis=2) < reach).any(axis=1)
+    p = uv[tri[near]]
+    e = np.sort(np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2), axis=1)
+    return float((e[:, 1] / e[:, 2]).max())
+
+
+def test_anneal_corners_mends_an_acute_corner_the_descent_cannot():
+    """A face with a 30° corner (a wedge's end cap): the repair's descent and
+    edits, with their shaken restarts, leave a triangle at 0.92 near the
+    corner (its two edges' samples side by side, where they must stagger).
+    Annealing the corner's samples brings every triangle within
+    ``ANNEAL_REACH`` h of it below 0.85 and the face's worst ratio down; the
+    edges' samples stay on their edges in their order, no moved sample
+    comes nearer than ``SHORT`` h to another, and the answer is the same
+    every time."""
+    uv, free, kw = _acute_triangle(30.0, 10.0)
+    first = repair(uv, free, 1.0, **kw)
+    assert _near_apex_worst(first.uv, kw["inside"], ANNEAL_REACH) > 0.9
+    annealed = anneal_corners(uv, free, 1.0, first, **kw)
+    assert _near_apex_worst(annealed.uv, kw["inside"], ANNEAL_REACH) < 0.845
+    assert annealed.worst < first.worst - 0.05
+    on_edge = np.flatnonzero((annealed.origin >= 0) & kw["slide"][np.maximum(annealed.origin, 0)])
+    q = annealed.uv[on_edge]
+    assert np.abs(kw["project"](q) - q).max() < 1e-9
+    # the order along each of the apex's edges is the input's
+    for sign in (-1.0, 1.0):
+        mine = on_edge[(np.sign(q[:, 1]) == sign) & (q[:, 0] < 9.5)]
+        moved = annealed.uv[mine, 0]
+        was = uv[annealed.origin[mine], 0]
+        assert (np.argsort(moved) == np.argsort(was)).all()
+    moved = np.flatnonzero((annealed.uv != first.uv).any(axis=1))
+    assert moved.size and (annealed.origin == first.origin).all()
+    assert cKDTree(annealed.uv).query(annealed.uv[moved], k=2)[0][:, 1].min() >= SHORT - 1e-9
+    again = anneal_corners(uv, free, 1.0, first, **kw)
+    assert again.uv.tobytes() == annealed.uv.tobytes()
+
+
+def test_corner_score_is_the_worst_ratio_of_the_corners_delaunay_triangles():
+    """The annealing's score (numba, its own Delaunay triangulation) against
+    scipy's: the worst ratio of the triangles whose centroid is in the
+    corner's sector and near its apex, plus a fifth of their excess above
+    0.8; its penalties count a gap on an edge outside the bounds."""
+    rng = np.random.default_rng(7)
+    half = np.radians(25.0)
+    rays = np.array([(np.cos(half), np.sin(half)), (np.cos(half), -np.sin(half))])
+    normals = np.array([(np.sin(half), -np.cos(half)), (np.sin(half), np.cos(half))])
+    pts = rng.random((60, 2)) * (6.0, 6.0) - (0.0, 3.0)
+    on_edges = np.array([k * r for r in rays for k in (1.0, 2.1, 3.0)])
+    pts = np.vstack([[(0.0, 0.0)], on_edges, pts])
+    edge = np.r_[2, 0, 0, 0, 1, 1, 1, -np.ones(60, dtype=np.int64)].astype(np.int64)
+    score, pen = corner_score(pts, edge, np.zeros(2), rays, normals, 4.0, 1.0, 0.75, 1.35, 0.0, 1e9)
+    tri = Delaunay(pts).simplices
+    c = pts[tri].mean(axis=1)
+    keep = (np.linalg.norm(c, axis=1) <= 4.0) & ((c @ normals.T) > 0).all(axis=1)
+    p = pts[tri[keep]]
+    e = np.sort(np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2), axis=1)
+    rho = e[:, 1] / e[:, 2]
+    assert score == pytest.approx(rho.max() + 0.2 * np.clip(rho - 0.8, 0, None).sum(), abs=1e-12)
+    # the gaps on both edges: 1.0, 1.1, 0.9 of which none is out of bounds
+    assert pen == pytest.approx(0.0, abs=1e-12)
+    wide = corner_score(pts, edge, np.zeros(2), rays, normals, 4.0, 1.0, 0.75, 1.0, 0.0, 1e9)[1]
+    assert wide == pytest.approx(10.0 * 2 * 0.1, abs=1e-9)  # the 1.1 gap on each edge
