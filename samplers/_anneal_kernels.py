@@ -2,12 +2,12 @@
 
 The repair (:mod:`sr33.samplers.repair`) is a descent with edits; round a
 planar face's corner below 60° it ends in a basin it cannot leave (a
-wedge's 30° corner: 0.883 from 40 shaken starts of 41, one below 0.85).
-There the two edges' samples must stagger near the corner, then stand
+wedge's 30° corner: 0.883 from 28 of 40 shaken starts, below 0.85 from
+2).  There the two edges' samples must stagger near the corner, then stand
 side by side, then let a sample in on the bisector, and a descent on a
 smooth energy does not reorder them.  :func:`anneal_corner` searches
 instead: one sample at a time moves by a seeded normal step (a free sample
-in the corner's sector, an edge's sample along its edge), the Delaunay
+within its sector, an edge's sample along its edge), the Delaunay
 triangles of the region are made anew (:func:`delaunay_triangles`), and the
 move is kept by Metropolis' rule on the region's score (its worst ratio
 first).  The random numbers are the kernel's own (SplitMix64, Box-Muller),
@@ -47,17 +47,32 @@ def _normal(state):
 
 
 @njit(cache=True)
-def corner_score(pts, edge, apex, dirs, normals, judged, h, gap_lo, gap_hi, short, wide):
-    """The score of a corner's region ``pts`` ((m, 2)): the worst ratio of
-    its Delaunay triangles whose centroid lies in the corner's sector (on
-    the inner side of both ``normals`` (2, 2) from ``apex``; ``dirs`` (2, 2)
-    the unit directions of its edges from the apex) within
-    ``judged`` of the apex plus 0.2 per unit of ratio above 0.8 summed,
-    and apart the penalties: 2 per h of an edge below ``short`` h, 1 per h
-    of circumradius above ``wide`` h, 10 per h of a gap between neighbours
-    on one edge (``edge``: 0 or 1 for the samples on the corner's two
-    edges, the apex on both, -1 elsewhere) outside ``[gap_lo, gap_hi]`` h.
-    Both infinite where the points cannot be triangulated."""
+def _in_sector(dirs, x, y, clear):
+    """Whether ``(x, y)`` lies in one of the sectors between consecutive rays
+    ``dirs`` (counter-clockwise, each less than 180° wide) at least ``clear``
+    inside both of its rays; the sector's index, or -1."""
+    for s in range(dirs.shape[0] - 1):
+        if (
+            dirs[s, 0] * y - dirs[s, 1] * x > clear
+            and x * dirs[s + 1, 1] - y * dirs[s + 1, 0] > clear
+        ):
+            return s
+    return -1
+
+
+@njit(cache=True)
+def corner_score(pts, ray, dirs, judged, h, gap_lo, gap_hi, short, wide):
+    """The score of a corner's region ``pts`` ((m, 2), the corner at the
+    origin): the worst ratio of its Delaunay triangles whose centroid lies
+    within ``judged`` of the corner and in one of the sectors between its
+    rays ``dirs`` ((k, 2) unit, counter-clockwise, consecutive ones less
+    than 180° apart: a planar face's two edges at its corner), plus 0.2
+    per unit of ratio above 0.8 summed; and apart the penalties: 2 per h
+    of an edge below ``short`` h, 1 per h of circumradius above ``wide``
+    h, 10 per h of a gap between neighbours on one ray outside
+    ``[gap_lo, gap_hi]`` h (``ray``: the ray a sample lies on, -2 for the
+    corner, on all, -1 for none).  Both infinite where the points cannot
+    be triangulated."""
     got = delaunay_triangles(pts, 1e-9 * h * h, 1e-10 * h**4)
     if got is None:
         return np.inf, np.inf
@@ -67,13 +82,9 @@ def corner_score(pts, edge, apex, dirs, normals, judged, h, gap_lo, gap_hi, shor
     pen = 0.0
     for t in range(tri.shape[0]):
         a, b, c = tri[t, 0], tri[t, 1], tri[t, 2]
-        cx = (pts[a, 0] + pts[b, 0] + pts[c, 0]) / 3.0 - apex[0]
-        cy = (pts[a, 1] + pts[b, 1] + pts[c, 1]) / 3.0 - apex[1]
-        if cx * cx + cy * cy > judged * judged:
-            continue
-        if cx * normals[0, 0] + cy * normals[0, 1] <= 0.0:
-            continue
-        if cx * normals[1, 0] + cy * normals[1, 1] <= 0.0:
+        cx = (pts[a, 0] + pts[b, 0] + pts[c, 0]) / 3.0
+        cy = (pts[a, 1] + pts[b, 1] + pts[c, 1]) / 3.0
+        if cx * cx + cy * cy > judged * judged or _in_sector(dirs, cx, cy, 0.0) < 0:
             continue
         la = math.hypot(pts[b, 0] - pts[c, 0], pts[b, 1] - pts[c, 1])
         lb = math.hypot(pts[c, 0] - pts[a, 0], pts[c, 1] - pts[a, 1])
@@ -93,20 +104,18 @@ def corner_score(pts, edge, apex, dirs, normals, judged, h, gap_lo, gap_hi, shor
             pen += max(0.0, la * lb * lc / (2.0 * area2) / h - wide)
         else:
             pen += 1e6
-    # the gaps between neighbours along each edge
+    # the gaps between neighbours along each ray
     m = pts.shape[0]
-    for e in range(2):
-        ux = dirs[e, 0]
-        uy = dirs[e, 1]
+    for e in range(dirs.shape[0]):
         cnt = 0
         for i in range(m):
-            if edge[i] == e or edge[i] == 2:
+            if ray[i] == e or ray[i] == -2:
                 cnt += 1
         ts = np.empty(cnt)
         k = 0
         for i in range(m):
-            if edge[i] == e or edge[i] == 2:
-                ts[k] = (pts[i, 0] - apex[0]) * ux + (pts[i, 1] - apex[1]) * uy
+            if ray[i] == e or ray[i] == -2:
+                ts[k] = pts[i, 0] * dirs[e, 0] + pts[i, 1] * dirs[e, 1]
                 k += 1
         ts.sort()
         for k in range(cnt - 1):
@@ -119,10 +128,8 @@ def corner_score(pts, edge, apex, dirs, normals, judged, h, gap_lo, gap_hi, shor
 def anneal_corner(
     pts,
     kind,
-    edge,
-    apex,
+    ray,
     dirs,
-    normals,
     reach,
     judged,
     clear,
@@ -136,26 +143,31 @@ def anneal_corner(
     sigma,
     t0,
 ):
-    """One seeded annealing of a corner's region (:func:`corner_score`).
+    """One seeded annealing of a corner's region (:func:`corner_score`; the
+    corner at the origin).
 
-    ``kind`` says which samples move: ``FREE`` ones anywhere in the sector
-    at least ``clear`` h inside both edges and within ``reach`` of the
-    apex, ``ON_EDGE`` ones along their edge (``edge`` 0 or 1) within
-    ``reach``, keeping their order on it; ``FIXED`` ones stay.  A move
-    that brings a sample nearer than ``short`` h to another is refused.
-    ``moves`` steps, each of one sample (drawn uniformly) by a normal step
-    of ``sigma`` h, accepted by Metropolis' rule at a temperature falling
-    geometrically from ``t0`` to ``t0 / 1000``, on the ratio's part of the
-    score; a move that makes the penalties' part exceed the start's is
-    refused (the annealing trades no spacing for a ratio).  Returns the best
-    points met and their ratio score."""
+    ``kind`` says which samples move: ``FREE`` ones within their sector
+    (the one they start in), at least ``clear`` h inside both its rays and
+    within ``reach`` of the corner, ``ON_EDGE`` ones along their ray
+    within ``reach``, keeping their order on it; ``FIXED`` ones stay.  A
+    move that brings a sample nearer than ``short`` h to another is
+    refused.  ``moves`` steps, each of one sample (drawn uniformly) by a
+    normal step of ``sigma`` h, accepted by Metropolis' rule at a
+    temperature falling geometrically from ``t0`` to ``t0 / 1000``, on the
+    ratio's part of the score; a move that makes the penalties' part exceed
+    the start's is refused (the annealing trades no spacing for a ratio).
+    Returns the best points met and their ratio score."""
     m = pts.shape[0]
     p = pts.copy()
     movable = np.flatnonzero(kind != FIXED)
-    score, cap = corner_score(p, edge, apex, dirs, normals, judged, h, gap_lo, gap_hi, short, wide)
+    score, cap = corner_score(p, ray, dirs, judged, h, gap_lo, gap_hi, short, wide)
     if movable.size == 0:
         return p, score
     cap += 1e-9
+    sector = np.full(m, -1, dtype=np.int64)
+    for i in range(m):
+        if kind[i] == FREE:
+            sector[i] = _in_sector(dirs, p[i, 0], p[i, 1], 0.0)
     state = np.uint64(seed) * np.uint64(0x2545F4914F6CDD1D) + np.uint64(1)
     best = p.copy()
     best_score = score
@@ -167,36 +179,38 @@ def anneal_corner(
         i = movable[min(int(u * movable.size), movable.size - 1)]
         ox, oy = p[i, 0], p[i, 1]
         if kind[i] == ON_EDGE:
-            e = edge[i]
+            e = ray[i]
             ux, uy = dirs[e, 0], dirs[e, 1]
-            t = (ox - apex[0]) * ux + (oy - apex[1]) * uy
+            t = ox * ux + oy * uy
             state, z = _normal(state)
             nt = t + sigma * h * z
             if nt > reach or nt <= 0.0:
                 continue
-            # keep the order along the edge: no neighbour passed
+            # keep the order along the ray: no neighbour passed
             passed = False
             for j in range(m):
-                if j != i and (edge[j] == e or edge[j] == 2):
-                    tj = (p[j, 0] - apex[0]) * ux + (p[j, 1] - apex[1]) * uy
+                if j != i and (ray[j] == e or ray[j] == -2):
+                    tj = p[j, 0] * ux + p[j, 1] * uy
                     if (tj - t) * (tj - nt) < 0.0:
                         passed = True
                         break
             if passed:
                 continue
-            nx = apex[0] + nt * ux
-            ny = apex[1] + nt * uy
+            nx = nt * ux
+            ny = nt * uy
         else:
             state, zx = _normal(state)
             state, zy = _normal(state)
             nx = ox + sigma * h * zx
             ny = oy + sigma * h * zy
-            dx, dy = nx - apex[0], ny - apex[1]
-            if dx * dx + dy * dy > reach * reach:
+            if nx * nx + ny * ny > reach * reach:
                 continue
-            if dx * normals[0, 0] + dy * normals[0, 1] < clear * h:
+            s = sector[i]
+            if s < 0:
                 continue
-            if dx * normals[1, 0] + dy * normals[1, 1] < clear * h:
+            if dirs[s, 0] * ny - dirs[s, 1] * nx < clear * h:
+                continue
+            if nx * dirs[s + 1, 1] - ny * dirs[s + 1, 0] < clear * h:
                 continue
         near = False
         for j in range(m):
@@ -206,7 +220,7 @@ def anneal_corner(
         if near:
             continue
         p[i, 0], p[i, 1] = nx, ny
-        s2, pen = corner_score(p, edge, apex, dirs, normals, judged, h, gap_lo, gap_hi, short, wide)
+        s2, pen = corner_score(p, ray, dirs, judged, h, gap_lo, gap_hi, short, wide)
         state, u = _next(state)
         if pen <= cap and (s2 < score or u < math.exp(-(s2 - score) / temp)):
             score = s2

@@ -340,12 +340,16 @@ def _slanted_lines(
             continue
         a2, b2 = to2d(np.stack([a3, b3]))
         m, m3 = _inward(n, a3, u, a2, b2, to2d, raster, h)
-        sel = np.flatnonzero((s.face_id == fb) & ~s.on_feature)
+        # the samples on the other face's plane, its edges' too (the
+        # geodesics from this face's corner samples cross to them), but not
+        # those on this edge, which are this face's own
+        n_fb = np.array(faces[fb].normalAt().toTuple())
+        sel = np.flatnonzero(np.abs(dot(s.points - a3, n_fb)) < 1e-6 * h)
         q = s.points[sel]
         t = dot(q - a3, u)
         foot = a3 + t[:, None] * u
         dist = np.linalg.norm(q - foot, axis=1)
-        near = (t > 0) & (t < length) & (dist < LAYER * h)
+        near = (t > 0) & (t < length) & (dist < LAYER * h) & (dist > 1e-6 * h)
         unfolded = foot[near] - dist[near, None] * m3
         frame = to2d(unfolded) if near.any() else np.empty((0, 2))
         slides = not square and _slanted(faces[fb], np.asarray(row_dirs[fb]), u)

@@ -708,25 +708,27 @@ def test_anneal_corners_mends_an_acute_corner_the_descent_cannot():
 def test_corner_score_is_the_worst_ratio_of_the_corners_delaunay_triangles():
     """The annealing's score (numba, its own Delaunay triangulation) against
     scipy's: the worst ratio of the triangles whose centroid is in the
-    corner's sector and near its apex, plus a fifth of their excess above
-    0.8; its penalties count a gap on an edge outside the bounds."""
+    corner's sector and near its corner, plus a fifth of their excess above
+    0.8; its penalties count a gap on a ray outside the bounds."""
     rng = np.random.default_rng(7)
     half = np.radians(25.0)
-    rays = np.array([(np.cos(half), np.sin(half)), (np.cos(half), -np.sin(half))])
-    normals = np.array([(np.sin(half), -np.cos(half)), (np.sin(half), np.cos(half))])
+    dirs = np.array([(np.cos(half), -np.sin(half)), (np.cos(half), np.sin(half))])
     pts = rng.random((60, 2)) * (6.0, 6.0) - (0.0, 3.0)
-    on_edges = np.array([k * r for r in rays for k in (1.0, 2.1, 3.0)])
-    pts = np.vstack([[(0.0, 0.0)], on_edges, pts])
-    edge = np.r_[2, 0, 0, 0, 1, 1, 1, -np.ones(60, dtype=np.int64)].astype(np.int64)
-    score, pen = corner_score(pts, edge, np.zeros(2), rays, normals, 4.0, 1.0, 0.75, 1.35, 0.0, 1e9)
+    on_rays = np.array([k * d for d in dirs for k in (1.0, 2.1, 3.0)])
+    pts = np.vstack([[(0.0, 0.0)], on_rays, pts])
+    ray = np.r_[-2, 0, 0, 0, 1, 1, 1, -np.ones(60, dtype=np.int64)].astype(np.int64)
+    score, pen = corner_score(pts, ray, dirs, 4.0, 1.0, 0.75, 1.35, 0.0, 1e9)
     tri = Delaunay(pts).simplices
     c = pts[tri].mean(axis=1)
-    keep = (np.linalg.norm(c, axis=1) <= 4.0) & ((c @ normals.T) > 0).all(axis=1)
-    p = pts[tri[keep]]
+    in_sector = (dirs[0, 0] * c[:, 1] - dirs[0, 1] * c[:, 0] > 0) & (
+        c[:, 0] * dirs[1, 1] - c[:, 1] * dirs[1, 0] > 0
+    )
+    p = pts[tri[(np.linalg.norm(c, axis=1) <= 4.0) & in_sector]]
     e = np.sort(np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2), axis=1)
     rho = e[:, 1] / e[:, 2]
+    assert rho.size > 5
     assert score == pytest.approx(rho.max() + 0.2 * np.clip(rho - 0.8, 0, None).sum(), abs=1e-12)
-    # the gaps on both edges: 1.0, 1.1, 0.9 of which none is out of bounds
+    # the gaps on both rays: 1.0, 1.1, 0.9 of which none is out of bounds
     assert pen == pytest.approx(0.0, abs=1e-12)
-    wide = corner_score(pts, edge, np.zeros(2), rays, normals, 4.0, 1.0, 0.75, 1.0, 0.0, 1e9)[1]
-    assert wide == pytest.approx(10.0 * 2 * 0.1, abs=1e-9)  # the 1.1 gap on each edge
+    tight = corner_score(pts, ray, dirs, 4.0, 1.0, 0.75, 1.0, 0.0, 1e9)[1]
+    assert tight == pytest.approx(10.0 * 2 * 0.1, abs=1e-9)  # the 1.1 gap on each ray
