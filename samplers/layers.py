@@ -315,9 +315,17 @@ def _slanted_lines(
 ) -> list[_Line]:
     """Sharp straight edges of a planar face, between it and another planar
     face, neither parallel nor perpendicular to the face's scan rows (those
-    rows end on them at arbitrary places); with the other face's samples
-    within ``LAYER`` h of the edge unfolded into this face's plane (exact for
-    a polyhedral edge: geodesics across it unfold to straight lines).  An
+    rows end on them at arbitrary places); with the other face's scan-line
+    samples within ``LAYER`` h of the edge unfolded into this face's plane
+    (exact for a polyhedral edge: geodesics across it unfold to straight
+    lines).  Along a square edge (``squares``) the frame is every sample on
+    the other face's plane there, on its side, its edges' too, but not
+    this edge's nor any that unfolds onto this face's own samples: a
+    prism over a 25° triangle, its ends repaired before its sides, kept
+    triangles of 0.987 at the ends, one corner on a side and two on the
+    end's edges, which the side's frame of the end's scan-line samples did
+    not hold.  (For a slanted edge that frame re-rolled a turned star
+    prism's repair: 0.8401 -> 0.8529.)  An
     edge slanted to the other face's rows too slides.  One parallel to them
     holds the ends of that face's columns: where that face is a plain
     lattice (:func:`_plain_lattice`), its samples slide too (``follows``),
@@ -340,18 +348,39 @@ def _slanted_lines(
             continue
         a2, b2 = to2d(np.stack([a3, b3]))
         m, m3 = _inward(n, a3, u, a2, b2, to2d, raster, h)
-        # the samples on the other face's plane, its edges' too (the
-        # geodesics from this face's corner samples cross to them), but not
-        # those on this edge, which are this face's own
-        n_fb = np.array(faces[fb].normalAt().toTuple())
-        sel = np.flatnonzero(np.abs(dot(s.points - a3, n_fb)) < 1e-6 * h)
+        if square:
+            # the samples on the other face's plane, its edges' too (the
+            # geodesics from this face's corner samples cross to them), but
+            # not those on this edge, which are this face's own
+            n_fb = np.array(faces[fb].normalAt().toTuple())
+            sel = np.flatnonzero(np.abs(dot(s.points - a3, n_fb)) < 1e-6 * h)
+        else:
+            sel = np.flatnonzero((s.face_id == fb) & ~s.on_feature)
         q = s.points[sel]
         t = dot(q - a3, u)
         foot = a3 + t[:, None] * u
         dist = np.linalg.norm(q - foot, axis=1)
         near = (t > 0) & (t < length) & (dist < LAYER * h) & (dist > 1e-6 * h)
+        if square:
+            # on the other face's side of the edge only (its plane goes on
+            # beyond a reflex edge: a union of boxes), that side told by the
+            # face's own scan-line samples
+            own = near & (s.face_id[sel] == fb) & ~s.on_feature[sel]
+            if own.any():
+                side = (q[own] - foot[own]).sum(axis=0)
+                near &= dot(q - foot, side) > 0
+            else:
+                near &= (s.face_id[sel] == fb) & ~s.on_feature[sel]
         unfolded = foot[near] - dist[near, None] * m3
         frame = to2d(unfolded) if near.any() else np.empty((0, 2))
+        if square and frame.shape[0]:
+            # none unfolded onto this face's own samples (beside a reflex
+            # corner of the other face, its edge there unfolds onto an edge
+            # of this one: two boxes' union, flush on one side)
+            mine = np.abs(dot(s.points - a3, n)) < 1e-6 * h
+            if mine.any():
+                d, _ = cKDTree(s.points[mine]).query(unfolded)
+                frame = frame[d > 0.5 * h]
         slides = not square and _slanted(faces[fb], np.asarray(row_dirs[fb]), u)
         follows = (
             not square
