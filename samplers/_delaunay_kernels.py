@@ -34,7 +34,7 @@ import numpy as np
 
 from sr33.jit import njit
 
-from ._repair_kernels import _incircle
+from ._repair_kernels import incircle
 
 
 @njit(cache=True)
@@ -104,7 +104,7 @@ def _legalize(pts, tris, halfedges, hull_tri, hull_prev, hull_start, a, tol_circ
         bl = b0 + (b + 2) % 3
         p0 = tris[ar]
         p1 = tris[bl]
-        if _incircle(pts, tris[a0], tris[a0 + 1], tris[a0 + 2], p1) > tol_circle:
+        if incircle(pts, tris[a0], tris[a0 + 1], tris[a0 + 2], p1) > tol_circle:
             tris[a] = p1
             tris[b] = p0
             hbl = halfedges[bl]

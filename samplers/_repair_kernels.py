@@ -369,7 +369,7 @@ def _flips(pts, tri, nbr, tol_area, tol_circle, moved):
         while tri[u, j] == b or tri[u, j] == c:
             j += 1
         d = tri[u, j]  # u is (d, c, b) counter-clockwise from j
-        if _incircle(pts, a, b, c, d) <= tol_circle:
+        if incircle(pts, a, b, c, d) <= tol_circle:
             continue
         nt_b = nbr[t, (k + 1) % 3]  # across (c, a)
         nt_c = nbr[t, (k + 2) % 3]  # across (a, b)
@@ -496,7 +496,7 @@ def canonical_reorder(tri, nbr, before):
 
 
 @njit(cache=True)
-def _incircle(pts, a, b, c, d):
+def incircle(pts, a, b, c, d):
     """Positive when ``d`` lies inside the circle through the counter-clockwise ``a, b, c``."""
     adx = pts[a, 0] - pts[d, 0]
     ady = pts[a, 1] - pts[d, 1]

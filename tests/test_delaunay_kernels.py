@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from scipy.spatial import ConvexHull, Delaunay
 
 from sr33.samplers._delaunay_kernels import delaunay_triangles
-from sr33.samplers._repair_kernels import _incircle, delaunay_flips
+from sr33.samplers._repair_kernels import delaunay_flips, incircle
 
 
 def _valid(pts, tri, nbr, tol_circle):
@@ -34,7 +34,7 @@ def _valid(pts, tri, nbr, tol_circle):
             side = {tri[t, (k + 1) % 3], tri[t, (k + 2) % 3]}
             assert side <= set(tri[u].tolist()) and t in nbr[u]
             far = (set(tri[u].tolist()) - side).pop()
-            assert _incircle(pts, tri[t, 0], tri[t, 1], tri[t, 2], far) <= tol_circle
+            assert incircle(pts, tri[t, 0], tri[t, 1], tri[t, 2], far) <= tol_circle
     # every hull side once: 2n - h - 2 triangles
     assert len(tri) == 2 * len(pts) - (nbr < 0).sum() - 2
 
