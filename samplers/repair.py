@@ -60,7 +60,6 @@ from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
 
 from ._anneal_kernels import FIXED, FREE, ON_EDGE, anneal_corner, corner_score
-from ._delaunay_kernels import delaunay_triangles
 from ._descent_kernels import QHULL, descend
 from ._repair_kernels import (
     canonical_order,
@@ -382,15 +381,14 @@ def _delaunay(prob: _Problem, pts: np.ndarray, of: np.ndarray) -> np.ndarray:
                 tri, nbr = canonical_reorder(tri, nbr, last[2])
             prob.delaunay = (last[0], pts, tri, nbr)
             return tri
-    swept = delaunay_triangles(pts, KEEP_AREA * h * h, KEEP_CIRCLE * h**4)
-    if swept is None:
-        try:
-            d = Delaunay(pts)
-        except QhullError:
-            prob.delaunay = None
-            return np.empty((0, 3), dtype=np.int64)
-        swept = _without_flat_hull(pts, d.simplices, d.neighbors, KEEP_AREA * h * h)
-    tri, nbr, smallest = canonical_triangles(pts, *swept)
+    try:
+        d = Delaunay(pts)
+    except QhullError:
+        prob.delaunay = None
+        return np.empty((0, 3), dtype=np.int64)
+    tri, nbr, smallest = canonical_triangles(
+        pts, *_without_flat_hull(pts, d.simplices, d.neighbors, KEEP_AREA * h * h)
+    )
     # kept for the next step only when it can be checked there: every point
     # a corner, no flat triangle
     used = np.zeros(pts.shape[0], dtype=bool)
@@ -694,7 +692,7 @@ def _descend_fused(
         KEEP_CIRCLE * h**4,
     )
     empty = (np.empty(0, dtype=np.int64), np.empty((0, 2)), np.empty((0, 3), dtype=np.int64))
-    why, ran, best, since, of, pts, tri, nbr, changed = descend(
+    why, ran, best, since, pts, tri, nbr, changed = descend(
         prob.uv,
         prob.free,
         prob.slide,
@@ -713,7 +711,7 @@ def _descend_fused(
         **form,
     )
     if changed:
-        prob.delaunay = (of, pts, tri, nbr) if of.size else None
+        prob.delaunay = (last[0], pts, tri, nbr)
     return why, ran, best, since
 
 

@@ -1550,13 +1550,6 @@ def _notched_cylinder():
     return shapes.from_cad(solid, name="notched cylinder")
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="stop 62: the repair's own Delaunay kernel took the notched cylinder's "
-    "chart repair down another path; it ends at 0.8646 with one bad triangle at "
-    "the bottom rim (0.842 through Qhull), between the bar and sqrt(3)/2, where "
-    "the chart's shaken starts (seeds 6-10) do not mend it (seeds 10-18 do: luck)",
-)
 def test_a_cylinder_notched_by_a_ball_is_repaired_in_its_charts():
     """Faces no layout takes are repaired in charts of their own, whatever
     their rims (:mod:`sr33.samplers.outlines`): the ball's dish on its
