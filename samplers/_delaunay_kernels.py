@@ -1,12 +1,15 @@
-"""numba kernel: the Delaunay triangulation of a repair's few hundred points.
+"""numba kernel: the Delaunay triangulation of a few hundred points.
 
-The repair (:mod:`sr33.samplers.repair`) triangulates anew after every edit
-(a sample added or removed) and for every local search: thousands of calls
-on 80-220 points per face.  Qhull took 0.2 ms for 140 points in general
-position and 0.56 ms on a lattice's cocircular squares, whose facets it
-merges and triangulates again (``Qt``): a third of a default sampling.
-This is the sweep-hull construction of Delaunator (V. Agafonkin, 2017; after
-Sinclair's s-hull, 2010) with Lawson's flips, in one loop: the points are
+The corners' annealing (:mod:`sr33.samplers._anneal_kernels`) triangulates
+its region anew after every move: 12,000 calls on 30-130 points, inside a
+numba loop, where Qhull cannot be called (it took 0.2 ms for 140 points in
+general position, 0.56 ms on a lattice's cocircular squares; this kernel
+24 µs).  The repair itself triangulates by Qhull: on this kernel every
+sampling took another path and seven tests whose paths were lucky broke
+(docs/sampler.md, stop 62).
+
+This is the sweep-hull construction of Delaunator (V. Agafonkin, 2017;
+after Sinclair's s-hull, 2010) with Lawson's flips, in one loop: the points are
 added in order of their distance from the circumcentre of a seed triangle,
 each one outside the hull of those before it, joined to the hull edges it
 sees, and the edges opposite it flipped until locally Delaunay.

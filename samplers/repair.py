@@ -1114,6 +1114,28 @@ def _corner_wedge(r: Repaired, fixed: np.ndarray, inside) -> tuple[int, np.ndarr
     return None
 
 
+def _corner_inputs(uv, free, kwargs: dict):
+    """The inputs of a repair retried at its corners (:func:`split_corners`,
+    :func:`anneal_corners`): ``uv`` and ``free`` as arrays, ``slide`` and
+    ``anchors`` popped from the repair's ``kwargs`` (as masks, none
+    without them), its ``inside`` test, and its keyword arguments for a
+    judging repair (no descent, no edits)."""
+    uv = np.asarray(uv, dtype=np.float64)
+    n = uv.shape[0]
+    slide = kwargs.pop("slide", None)
+    anchors = kwargs.pop("anchors", None)
+    judge_kw = {k: v for k, v in kwargs.items() if k not in ("descent_steps", "max_edits")}
+    judge_kw.update(descent_steps=0, max_edits=0)
+    return (
+        uv,
+        np.asarray(free, dtype=bool),
+        np.zeros(n, dtype=bool) if slide is None else np.asarray(slide, dtype=bool),
+        np.zeros(n, dtype=bool) if anchors is None else np.asarray(anchors, dtype=bool),
+        kwargs.get("inside") or (lambda c: np.ones(c.shape[0], dtype=bool)),
+        judge_kw,
+    )
+
+
 def split_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
     """Split the angle at a fixed sample of a triangle left breaking Condition III-ii.
 
@@ -1149,16 +1171,8 @@ def split_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
     Repaired
         ``first``, or a better answer whose ``origin`` refers to ``uv``.
     """
-    uv = np.asarray(uv, dtype=np.float64)
+    uv, free, slide, anchors, inside, fixed_kw = _corner_inputs(uv, free, kwargs)
     n = uv.shape[0]
-    free = np.asarray(free, dtype=bool)
-    slide = kwargs.pop("slide", None)
-    slide = np.zeros(n, dtype=bool) if slide is None else np.asarray(slide, dtype=bool)
-    anchors = kwargs.pop("anchors", None)
-    anchors = np.zeros(n, dtype=bool) if anchors is None else np.asarray(anchors, dtype=bool)
-    inside = kwargs.get("inside") or (lambda c: np.ones(c.shape[0], dtype=bool))
-    fixed_kw = {k: v for k, v in kwargs.items() if k not in ("descent_steps", "max_edits")}
-    fixed_kw.update(descent_steps=0, max_edits=0)
 
     def _flags(flags: np.ndarray, of: np.ndarray, added: bool) -> np.ndarray:
         """``flags`` of the input samples ``of`` (``n``: a sample some repair added)."""
@@ -1348,58 +1362,47 @@ def anneal_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
     Repaired
         ``first``, or a better answer whose ``origin`` refers to ``uv``.
     """
-    uv = np.asarray(uv, dtype=np.float64)
-    n = uv.shape[0]
-    free = np.asarray(free, dtype=bool)
-    slide = kwargs.pop("slide", None)
-    slide = np.zeros(n, dtype=bool) if slide is None else np.asarray(slide, dtype=bool)
-    anchors = kwargs.pop("anchors", None)
-    if anchors is None or first.worst <= BAD or kwargs.get("turn") is not None:
+    if kwargs.get("anchors") is None or first.worst <= BAD or kwargs.get("turn") is not None:
         return first
-    anchors = np.asarray(anchors, dtype=bool)
-    inside = kwargs.get("inside") or (lambda c: np.ones(c.shape[0], dtype=bool))
-    judge_kw = {k: v for k, v in kwargs.items() if k not in ("descent_steps", "max_edits")}
-    judge_kw.update(descent_steps=0, max_edits=0)
+    uv, free, slide, anchors, inside, judge_kw = _corner_inputs(uv, free, kwargs)
+    n = uv.shape[0]
     out = first
+    # the annealing moves samples and keeps them all: the origins stay
     was = np.where(out.origin >= 0, out.origin, n)
+    movable_free = np.r_[free, True][was]
     sliding = np.r_[slide & ~anchors, False][was]
     anchored = np.r_[anchors, False][was]
     corners = _acute_corners(out.uv, sliding, anchored, h)
-    if not corners:
-        return first
+    bad = None  # the answer's triangles above BAD, made again once it changes
     for a, rays in corners:
         if out.worst <= BAD:
             break
-        try:
-            tri = Delaunay(out.uv).simplices
-        except QhullError:
-            break
-        tri = tri[inside(out.uv[tri].mean(axis=1))]
-        bad = tri[triangle_ratios(out.uv, tri) > BAD]
+        if bad is None:
+            try:
+                tri = Delaunay(out.uv).simplices
+            except QhullError:
+                break
+            tri = tri[inside(out.uv[tri].mean(axis=1))]
+            bad = tri[triangle_ratios(out.uv, tri) > BAD]
         apex = out.uv[a]
         if (
             not bad.size
             or np.linalg.norm(out.uv[bad.ravel()] - apex, axis=1).min() > ANNEAL_REACH * h
         ):
             continue
-        was = np.where(out.origin >= 0, out.origin, n)
-        movable_free = np.r_[free, True][was]
-        sliding = np.r_[slide & ~anchors, False][was]
         dist = np.linalg.norm(out.uv - apex, axis=1)
         local = np.flatnonzero(dist < (ANNEAL_REACH + 3.0) * h)
         local = local[np.lexsort((out.uv[local, 1], out.uv[local, 0]))]
         rel = out.uv[local] - apex
         cross = np.abs(rel[:, None, 0] * rays[None, :, 1] - rel[:, None, 1] * rays[None, :, 0])
         ahead = rel @ rays.T > 0
-        on = (cross < 1e-6 * h) & ahead & (sliding | np.r_[anchors, False][was])[local, None]
+        on = (cross < 1e-6 * h) & ahead & (sliding | anchored)[local, None]
         edge = np.where(on[:, 0], 0, np.where(on[:, 1], 1, -1))
         edge[local == a] = 2
         reach = dist[local] < ANNEAL_REACH * h
         kind = np.full(local.size, FIXED, dtype=np.int64)
         kind[reach & movable_free[local]] = FREE
         kind[reach & sliding[local] & (edge >= 0) & (edge < 2)] = ON_EDGE
-        if not (kind != FIXED).any():
-            continue
         if rays[0, 0] * rays[1, 1] - rays[0, 1] * rays[1, 0] < 0:  # counter-clockwise
             rays = rays[::-1].copy()
             edge = np.where((edge == 0) | (edge == 1), 1 - edge, edge)
@@ -1412,7 +1415,7 @@ def anneal_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
         trial_uv[local] = best
         judged = repair(
             trial_uv,
-            np.r_[free, True][was],
+            movable_free,
             h,
             slide=np.r_[slide, False][was],
             anchors=np.r_[anchors, False][was],
@@ -1427,4 +1430,5 @@ def anneal_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
         )
         if judged.worst < out.worst and (judged.bad <= out.bad or judged.worst < GOOD_ENOUGH):
             out = Repaired(uv=trial_uv, origin=out.origin, bad=judged.bad, worst=judged.worst)
+            bad = None
     return out
