@@ -1,12 +1,12 @@
 """numba kernel: the Delaunay triangulation of a few hundred points.
 
-The corners' annealing (:mod:`sr33.samplers._anneal_kernels`) triangulates
-its region anew after every move: 12,000 calls on 30-130 points, inside a
-numba loop, where Qhull cannot be called (it took 0.2 ms for 140 points in
-general position, 0.56 ms on a lattice's cocircular squares; this kernel
-24 µs).  The repair itself triangulates by Qhull: on this kernel every
-sampling took another path and seven tests whose paths were lucky broke
-(docs/sampler.md, stop 62).
+The repair (:mod:`sr33.samplers.repair`) triangulates anew wherever its
+samples' ids change (every edit's trial, every local status), inside the
+descent's numba loop too, and the corners' annealing
+(:mod:`sr33.samplers._anneal_kernels`) after every move: 12,000 calls on
+30-130 points.  Qhull took 0.2 ms for 140 points in general position,
+0.56 ms on a lattice's cocircular squares, and cannot be called from
+numba; this kernel 24 µs (docs/sampler.md, stops 61-63).
 
 This is the sweep-hull construction of Delaunator (V. Agafonkin, 2017;
 after Sinclair's s-hull, 2010) with Lawson's flips, in one loop: the points are

@@ -9,9 +9,9 @@ Where every callback of a repair problem is one of the planar forms of
 their clamps and ghosts, an inside test by
 :class:`~sr33.samplers.chart.Raster`), :func:`descend` runs the steps
 here, calling the same kernels on the same arrays in the same order as the
-Python loop: bit for bit its samples.  It hands back to Python when a step
-needs Qhull (the points changed or an edge flip cannot mend the last
-triangulation), which triangulates anew and goes on.
+Python loop: bit for bit its samples.  It triangulates anew where the
+points changed or an edge flip cannot mend the last triangulation, and
+hands back to Python only where that needs Qhull.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ import numpy as np
 
 from sr33.jit import njit
 
+from ._delaunay_kernels import delaunay_triangles
 from ._line_kernels import (
     TWO_PI,
     clamp,
@@ -31,6 +32,7 @@ from ._line_kernels import (
     project_curves,
 )
 from ._repair_kernels import (
+    canonical_order,
     canonical_reorder,
     centroids,
     delaunay_flips_since,
@@ -253,6 +255,19 @@ def _clamped(q, parts, line_clamps, line_margins, arc_clamps):
 
 
 @njit(cache=True)
+def _smallest_area(pts, tri):
+    """Twice the smallest triangle's area (``repair._doubled_areas``)."""
+    out = np.inf
+    for t in range(tri.shape[0]):
+        a, b, c = tri[t, 0], tri[t, 1], tri[t, 2]
+        area = (pts[b, 0] - pts[a, 0]) * (pts[c, 1] - pts[a, 1]) - (pts[b, 1] - pts[a, 1]) * (
+            pts[c, 0] - pts[a, 0]
+        )
+        out = min(out, abs(area))
+    return out
+
+
+@njit(cache=True)
 def descend(
     uv,
     free,
@@ -300,10 +315,17 @@ def descend(
     ``glue`` = (turn, band, half, middle) of a development whose sides are
     glued (turn 0: none; ``repair._Problem.images`` and ``wrap``).
 
+    A step whose points are not the last triangulation's (an edit added or
+    removed a sample, one moved by more than the keep move) or whose flips
+    cannot mend it is triangulated anew here, by the repair's own sweep
+    (:func:`sr33.samplers._delaunay_kernels.delaunay_triangles`), as
+    ``repair._delaunay`` does; where the sweep gives up, Qhull is Python's.
+
     Returns why it stopped (``FINISHED``: the descent is over; ``QHULL``:
     the next step needs Qhull; ``OUT_OF_STEPS``), the steps made, the
     descent's best energy and steps since, and the last triangulation's
-    points, triangles and neighbours with whether they changed.
+    ids (none: not to be carried on), points, triangles and neighbours with
+    whether they changed.
     """
     (
         h,
@@ -342,15 +364,29 @@ def descend(
             (glue[0], glue[1], glue[2]),
         )
         if pts.shape[0] < 3:
-            return FINISHED, done, best, since, last_pts, last_tri, last_nbr, changed
-        if last_of.size == 0 or not same_points(last_of, of, last_pts, pts, keep_move):
-            return QHULL, done, best, since, last_pts, last_tri, last_nbr, changed
-        flipped = delaunay_flips_since(pts, last_pts, last_tri, last_nbr, keep_area, keep_circle)
-        if flipped is None:
-            return QHULL, done, best, since, last_pts, last_tri, last_nbr, changed
-        tri, nbr, flips = flipped
-        if flips:
-            tri, nbr = canonical_reorder(tri, nbr, last_tri)
+            return FINISHED, done, best, since, last_of, last_pts, last_tri, last_nbr, changed
+        anew = last_of.size == 0 or not same_points(last_of, of, last_pts, pts, keep_move)
+        tri, nbr = last_tri, last_nbr
+        if not anew:
+            flipped = delaunay_flips_since(
+                pts, last_pts, last_tri, last_nbr, keep_area, keep_circle
+            )
+            if flipped is None:
+                anew = True
+            else:
+                tri, nbr, flips = flipped
+                if flips:
+                    tri, nbr = canonical_reorder(tri, nbr, last_tri)
+        if anew:  # as repair._delaunay: the sweep, canonical, kept when checkable
+            swept = delaunay_triangles(pts, keep_area, keep_circle)
+            if swept is None:  # Qhull's
+                return QHULL, done, best, since, last_of, last_pts, last_tri, last_nbr, changed
+            t0, n0 = swept
+            tri, nbr = canonical_order(t0, n0)
+            if _smallest_area(pts, tri) > keep_area:
+                last_of = of
+            else:
+                last_of = np.empty(0, dtype=np.int64)
         last_pts, last_tri, last_nbr, changed = pts, tri, nbr, True
         # the face's triangles: inside it, or on its judged frame
         inside = _inside(centroids(pts, tri), inside_kind, raster, raster_cell, sector)
@@ -363,7 +399,7 @@ def descend(
             if inside[t]:
                 count += 1
         if count == 0:
-            return FINISHED, done, best, since, last_pts, last_tri, last_nbr, changed
+            return FINISHED, done, best, since, last_of, last_pts, last_tri, last_nbr, changed
         face = np.empty((count, 3), dtype=np.int64)
         row = 0
         for t in range(tri.shape[0]):
@@ -374,20 +410,20 @@ def descend(
             pts, of, face, move, hold, anchor, judged, reach, h, target, short, gap_lo, gap_hi, wide
         )
         if rho.size == 0 or rho.max() < stop:
-            return FINISHED, done, best, since, last_pts, last_tri, last_nbr, changed
+            return FINISHED, done, best, since, last_of, last_pts, last_tri, last_nbr, changed
         if energy < 0.99 * best:
             best, since = energy, 0
         else:
             since += 1
             if since >= 15:
-                return FINISHED, done, best, since, last_pts, last_tri, last_nbr, changed
+                return FINISHED, done, best, since, last_of, last_pts, last_tri, last_nbr, changed
         if turn != 0.0:  # an image's gradient, turned back onto its sample
             for k in range(gp.shape[0]):
                 gp[k, 0], gp[k, 1] = _turned(gp[k, 0], gp[k, 1], -turned[k])
         grad = gathered_gradient(of, gp, n, move)
         moved = descent_step(uv, grad, move, label, regions, step)
         if not moved.any():
-            return FINISHED, done, best, since, last_pts, last_tri, last_nbr, changed
+            return FINISHED, done, best, since, last_of, last_pts, last_tri, last_nbr, changed
         slid = moved & slide
         if has_projection and slid.any():
             on = project_curves(
@@ -421,4 +457,4 @@ def descend(
                         k = 1.0 if a >= glue[3] else -1.0
                     uv[v, 0], uv[v, 1] = _turned(uv[v, 0], uv[v, 1], k * turn)
         done += 1
-    return OUT_OF_STEPS, done, best, since, last_pts, last_tri, last_nbr, changed
+    return OUT_OF_STEPS, done, best, since, last_of, last_pts, last_tri, last_nbr, changed

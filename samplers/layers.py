@@ -97,6 +97,11 @@ FOLLOW_EDITS = 160  # ... when some of them slide with the columns of the face a
 #: (9 samples above issue 23's margin of 0.85); at 0.85 it reaches 0.843,
 #: sampled in 69 s instead of 20, and no other library shape changes
 STUCK = 0.85
+#: a shaken start's answer below this replaces one at or above STUCK (the
+#: margin) whatever their triangles above BAD (a scooped cutcube's sphere, turned: 0.8611
+#: with 1 kept against 0.8408 with 2, and the check read 0.8596; conebox's
+#: top, 0.850 with 5 against 0.859 with 2, read 0.979, stays out)
+CLEAR_OF_STUCK = 0.845
 RETRY_WIDE = 1.2  # a stuck face's repair runs again with circumradii up to this (times h)
 #: a repair left with at most this many bad triangles gets its corners split,
 #: and then further rounds while stuck (10 before stop 53: a slot's caps,
@@ -766,7 +771,9 @@ def unstuck(
     shaken starts (the repair's further attempts, however few its bad
     triangles, with new seeds), their best answer's corners split too,
     which replaces the answer before only when it is better on both counts:
-    a lower worst ratio and no more triangles above the margin.  A lower
+    a lower worst ratio and no more triangles above the margin, or when it
+    is below ``CLEAR_OF_STUCK`` and the answer before is not below the
+    margin (``STUCK``).  A lower
     worst bought with more bad triangles trades the chart's margin, not
     the surface's: conebox's top went from 0.859 with 2 to 0.850 with 5 in
     its chart, and to 0.979 by the geodesic check (its rim's ghost rows are
@@ -798,7 +805,9 @@ def unstuck(
             r.worst,
             r.bad,
         )
-        if shaken.worst < r.worst and shaken.bad <= r.bad:
+        if (shaken.worst < r.worst and shaken.bad <= r.bad) or (
+            shaken.worst < CLEAR_OF_STUCK and r.worst >= STUCK
+        ):
             r = shaken
     if r.worst >= stuck:
         r = anneal_corners(uv, free, h, r, **kwargs)  # r itself unless it beats it

@@ -60,6 +60,7 @@ from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
 
 from ._anneal_kernels import FIXED, FREE, ON_EDGE, anneal_corner, corner_score
+from ._delaunay_kernels import delaunay_triangles
 from ._descent_kernels import QHULL, descend
 from ._repair_kernels import (
     canonical_order,
@@ -114,7 +115,9 @@ GOOD_ENOUGH = 0.85  # further attempts (after a first one broke III-ii) end belo
 # planar face with straight edges only judges exactly and passes 1 (a
 # turned star prism: 0.923 and 0.859 -> 0.843 and 0.831)
 RETRY_BAD = 20
-ATTEMPTS = 6  # ... up to this many in all, from the input shaken
+ATTEMPTS = 6  # ... up to this many in all from the input shaken, and as many local ones
+LOCAL_SEED = 33  # ... by offsets of the stream (LOCAL_SEED, attempt)
+LOCAL_REACH = 5.0  # ... its free samples this near (times h) a bad triangle shaken and moved
 STALL = 16  # ... each ending after this many edits without fewer bad triangles
 GHOST, FRAME = -1, -2  # the sample id of a ghost point and of a frame point
 # a step's triangles are mended from the step before by edge flips
@@ -363,11 +366,14 @@ def _delaunay(prob: _Problem, pts: np.ndarray, of: np.ndarray) -> np.ndarray:
     its triangles are mended by Lawson's edge flips
     (:func:`sr33.samplers._repair_kernels.delaunay_flips_since`), which give the
     Delaunay triangles while every triangle is still counter-clockwise and
-    they tile the hull once; else Qhull triangulates anew.  Where four
-    points are cocircular within rounding (a lattice's squares) either
-    diagonal is Delaunay: the one already there is kept (Qhull's choice is
-    no better defined).  On a star prism's caps this took the sampling from
-    56 s to 27 s: Qhull's 38,000 calls cost 30 s, now 2,150 of them 1.7 s.
+    they tile the hull once; else they are triangulated anew by the sweep
+    kernel (:func:`sr33.samplers._delaunay_kernels.delaunay_triangles`,
+    its tie rule documented there), and by Qhull where it gives up.  Where
+    four points are cocircular within rounding (a lattice's squares) either
+    diagonal is Delaunay: the one already there is kept.  On a star prism's
+    caps the flips took the sampling from 56 s to 27 s (Qhull's 38,000
+    calls cost 30 s, then 2,150 of them 1.7 s); the sweep kernel, stop 63,
+    to 4.5 s.
     """
     h = prob.h
     last = prob.delaunay
@@ -381,14 +387,15 @@ def _delaunay(prob: _Problem, pts: np.ndarray, of: np.ndarray) -> np.ndarray:
                 tri, nbr = canonical_reorder(tri, nbr, last[2])
             prob.delaunay = (last[0], pts, tri, nbr)
             return tri
-    try:
-        d = Delaunay(pts)
-    except QhullError:
-        prob.delaunay = None
-        return np.empty((0, 3), dtype=np.int64)
-    tri, nbr, smallest = canonical_triangles(
-        pts, *_without_flat_hull(pts, d.simplices, d.neighbors, KEEP_AREA * h * h)
-    )
+    swept = delaunay_triangles(pts, KEEP_AREA * h * h, KEEP_CIRCLE * h**4)
+    if swept is None:
+        try:
+            d = Delaunay(pts)
+        except QhullError:
+            prob.delaunay = None
+            return np.empty((0, 3), dtype=np.int64)
+        swept = _without_flat_hull(pts, d.simplices, d.neighbors, KEEP_AREA * h * h)
+    tri, nbr, smallest = canonical_triangles(pts, *swept)
     # kept for the next step only when it can be checked there: every point
     # a corner, no flat triangle
     used = np.zeros(pts.shape[0], dtype=bool)
@@ -692,7 +699,7 @@ def _descend_fused(
         KEEP_CIRCLE * h**4,
     )
     empty = (np.empty(0, dtype=np.int64), np.empty((0, 2)), np.empty((0, 3), dtype=np.int64))
-    why, ran, best, since, pts, tri, nbr, changed = descend(
+    why, ran, best, since, of, pts, tri, nbr, changed = descend(
         prob.uv,
         prob.free,
         prob.slide,
@@ -711,7 +718,7 @@ def _descend_fused(
         **form,
     )
     if changed:
-        prob.delaunay = (last[0], pts, tri, nbr)
+        prob.delaunay = (of, pts, tri, nbr) if of.size else None
     return why, ran, best, since
 
 
@@ -904,13 +911,17 @@ def repair(
 
 
 def _search(
-    prob: _Problem, descent_steps: int, max_edits: int, stall: float = math.inf
+    prob: _Problem, descent_steps: int, max_edits: int, stall: float = math.inf, centres=None
 ) -> tuple[_Problem, int, float]:
-    """One attempt of :func:`repair`: a descent, then edits round the bad
+    """One attempt of :func:`repair`: a descent (of the samples within
+    ``LOCAL_REACH`` h of ``centres`` when given), then edits round the bad
     triangles until none is left, the edits run out, or ``stall`` edits
     pass without fewer bad triangles.  Returns the state, its bad triangles
     and its worst ratio."""
-    _descend(prob, descent_steps)
+    if centres is None:
+        _descend(prob, descent_steps)
+    else:
+        _descend(prob, descent_steps, *_union(prob, centres, LOCAL_REACH), centres=centres)
     nbad, _, bad, worst = _status(prob)
     edits = 0
     skip: set[tuple] = set()
@@ -955,22 +966,43 @@ def _attempts(start: _Problem, first, descent_steps: int, max_edits: int, shakes
     """Further attempts after a first one was left stuck (a triangle
     breaking III-ii and ``RETRY_BAD`` or more above the margin): the
     descent and the edits are a local search whose end depends on its path
-    (the last bits of the input can decide it), so the search starts again
-    from the input with its free samples shaken by seeded offsets (seed
-    a from ``shakes_from`` on: up to 0.03 h times 1 to 5 in turn, uniform
-    in a square), each
-    ending after ``STALL`` edits without progress.  The best answer by
-    :func:`_rank` is kept, the input itself among them (never worse than
-    it), and the attempts end once one is below ``GOOD_ENOUGH``."""
+    (the last bits of the input can decide it).  Two kinds, in turn, seed
+    a from ``shakes_from`` on: a local one, the best answer so far with its
+    free samples within ``LOCAL_REACH`` h of its bad triangles shaken, then
+    descended there and edited (it costs what the stuck place costs, not
+    the face); and one from the input with all its free samples shaken.
+    The offsets are seeded (:func:`_shake`: up to 0.03 h times 1 to 5 in
+    turn, uniform in a square), and each attempt ends after ``STALL`` edits
+    without progress.  The best answer by :func:`_rank` is kept, the input
+    itself among them (never worse than it), and the attempts end once one
+    is below ``GOOD_ENOUGH``, or after ``ATTEMPTS`` - 1 of each kind."""
     nbad, _, _, worst = _status(start)
     best = min((first, (start, nbad, worst)), key=_rank)
     for attempt in range(shakes_from, shakes_from + ATTEMPTS - 1):
-        if best[2] < GOOD_ENOUGH:
-            break
-        trial = start.copy()
-        _shake(trial, attempt)
-        answer = _search(trial, descent_steps, max_edits, STALL)
-        best = min((best, answer), key=_rank)
+        for local in (True, False):
+            if best[2] < GOOD_ENOUGH:
+                break
+            if local:
+                base = best[0]
+                bad = _status(base)[2]
+                if not bad[0].shape[0]:
+                    continue
+                centres = [c for _, c in _regions(base, bad, set(), spread=0.5 * LOCAL_REACH)]
+                trial = base.copy()
+                _shake(trial, attempt, near=(centres, LOCAL_REACH * base.h))
+            else:
+                centres = None
+                trial = start.copy()
+                _shake(trial, attempt)
+            answer = _search(trial, descent_steps, max_edits, STALL, centres=centres)
+            log.debug(
+                "repair attempt %d %s: %d bad (worst %.3f)",
+                attempt,
+                "from the input" if centres is None else f"near {len(centres)} places",
+                answer[1],
+                answer[2],
+            )
+            best = min((best, answer), key=_rank)
     log.debug(
         "repair attempts: first %d bad (worst %.3f), kept %d bad (worst %.3f)",
         first[1],
@@ -981,12 +1013,17 @@ def _attempts(start: _Problem, first, descent_steps: int, max_edits: int, shakes
     return best
 
 
-def _shake(prob: _Problem, attempt: int) -> None:
+def _shake(prob: _Problem, attempt: int, near=None) -> None:
     """Move the free samples by the seeded offsets of ``attempt`` (uniform in
     a square of half-side 0.03 h times 1 to 5, ``attempt`` modulo 5: the
-    same on every machine)."""
-    rng = np.random.default_rng(attempt)
+    same on every machine); with ``near`` = (centres, radius) only those
+    within ``radius`` of a centre, by offsets of another seeded stream."""
+    rng = np.random.default_rng(attempt if near is None else (LOCAL_SEED, attempt))
     free = np.flatnonzero(prob.free)
+    if near is not None:
+        centres, radius = near
+        d = np.min([prob.distance(np.asarray(c)) for c in centres], axis=0)
+        free = free[d[free] < radius]
     size = 0.03 * ((attempt - 1) % 5 + 1) * prob.h
     prob.uv[free] += (rng.random((free.size, 2)) * 2.0 - 1.0) * size
     if prob.clamp is not None and free.size:
@@ -1033,10 +1070,13 @@ def _key(centre: np.ndarray) -> tuple:
     return tuple(np.round(centre, 9).tolist())
 
 
-def _regions(prob: _Problem, bad, skip: set) -> list[tuple[np.ndarray, np.ndarray]]:
+def _regions(
+    prob: _Problem, bad, skip: set, spread: float = SEPARATION
+) -> list[tuple[np.ndarray, np.ndarray]]:
     """Bad triangles to edit at once: in order of their centres (x, then y),
-    skipping those already found stuck, each at least ``SEPARATION`` h from
-    the ones taken before it, so that their edits do not interact."""
+    skipping those already found stuck, each at least ``spread`` h
+    (``SEPARATION``) from the ones taken before it, so that their edits do
+    not interact."""
     bad, corners = bad
     real = bad >= 0  # a frame point is no sample: the centre is that of the real corners
     centres = prob.wrap((corners * real[..., None]).sum(axis=1) / real.sum(axis=1)[:, None])
@@ -1046,7 +1086,7 @@ def _regions(prob: _Problem, bad, skip: set) -> list[tuple[np.ndarray, np.ndarra
         if _key(centres[i]) in skip:
             continue
         gap = np.linalg.norm(centres[taken] - centres[i], axis=1)
-        if gap.size and gap.min() < SEPARATION * prob.h:
+        if gap.size and gap.min() < spread * prob.h:
             continue
         taken.append(i)
     return [(bad[i], centres[i]) for i in taken]
