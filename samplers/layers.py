@@ -98,9 +98,10 @@ FOLLOW_EDITS = 160  # ... when some of them slide with the columns of the face a
 #: sampled in 69 s instead of 20, and no other library shape changes
 STUCK = 0.85
 #: a shaken start's answer below this replaces one at or above STUCK (the
-#: margin) whatever their triangles above BAD (a scooped cutcube's sphere, turned: 0.8611
-#: with 1 kept against 0.8408 with 2, and the check read 0.8596; conebox's
-#: top, 0.850 with 5 against 0.859 with 2, read 0.979, stays out)
+#: margin) whatever their triangles above BAD (a scooped cutcube's sphere,
+#: turned: 0.8611 with 1 kept against 0.8408 with 2, and the check read
+#: 0.8596; conebox's top, 0.850 with 5 against 0.859 with 2, read 0.979,
+#: stays out)
 CLEAR_OF_STUCK = 0.845
 RETRY_WIDE = 1.2  # a stuck face's repair runs again with circumradii up to this (times h)
 #: a repair left with at most this many bad triangles gets its corners split,
@@ -773,8 +774,8 @@ def unstuck(
     which replaces the answer before only when it is better on both counts:
     a lower worst ratio and no more triangles above the margin, or when it
     is below ``CLEAR_OF_STUCK`` and the answer before is not below the
-    margin (``STUCK``).  A lower
-    worst bought with more bad triangles trades the chart's margin, not
+    margin (``STUCK``).  A lower worst bought with more bad triangles
+    (and not below ``CLEAR_OF_STUCK``) trades the chart's margin, not
     the surface's: conebox's top went from 0.859 with 2 to 0.850 with 5 in
     its chart, and to 0.979 by the geodesic check (its rim's ghost rows are
     not where the cone's rings will be).  Last, still stuck, its acute

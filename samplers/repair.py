@@ -26,10 +26,10 @@ Delaunay triangle meets the condition with a margin:
   path; a repair left stuck (a triangle breaking Condition III-ii, ratio
   at or above √3/2, and ``retry_bad`` or more above its margin: by
   default ``RETRY_BAD``, 1 on a face whose judged triangles are all exact)
-  makes
-  further attempts from its input, shaken by seeded offsets
-  (:func:`_attempts`), and keeps the best answer, never one worse than
-  the input;
+  makes further attempts (:func:`_attempts`), in turn from its best answer
+  with the samples near its bad triangles shaken and from its input
+  shaken, by seeded offsets, and keeps the best answer, never one worse
+  than the input;
 * :func:`split_corners`, for a face left with a few bad triangles at a
   fixed corner: a sample added on the corner's bisector, and the repair
   run again.
