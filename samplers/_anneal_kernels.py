@@ -22,7 +22,7 @@ import numpy as np
 
 from sr33.jit import njit
 
-from ._delaunay_kernels import delaunay_triangles
+from ._delaunay_kernels import delaunay_triangles, orient
 
 FREE, ON_EDGE, FIXED = 0, 1, 2  # the kinds of a region's samples
 
@@ -96,10 +96,7 @@ def corner_score(pts, ray, dirs, judged, h, gap_lo, gap_hi, short, wide):
         over += max(0.0, rho - 0.8)
         for ln in (la, lb, lc):
             pen += 2.0 * max(0.0, short - ln / h)
-        area2 = abs(
-            (pts[b, 0] - pts[a, 0]) * (pts[c, 1] - pts[a, 1])
-            - (pts[b, 1] - pts[a, 1]) * (pts[c, 0] - pts[a, 0])
-        )
+        area2 = abs(orient(pts, a, b, c))
         if area2 > 0.0:
             pen += max(0.0, la * lb * lc / (2.0 * area2) / h - wide)
         else:

@@ -41,7 +41,7 @@ from ._repair_kernels import incircle
 
 
 @njit(cache=True)
-def _orient(pts, a, b, c):
+def orient(pts, a, b, c):
     """Twice the signed area of (a, b, c): positive counter-clockwise."""
     return (pts[b, 0] - pts[a, 0]) * (pts[c, 1] - pts[a, 1]) - (pts[b, 1] - pts[a, 1]) * (
         pts[c, 0] - pts[a, 0]
@@ -184,14 +184,14 @@ def delaunay_triangles(pts, tol_area, tol_circle):
     for i in range(n):
         if i == i0 or i == i1:
             continue
-        if abs(_orient(pts, i0, i1, i)) <= tol_area:
+        if abs(orient(pts, i0, i1, i)) <= tol_area:
             continue
         r = _circumradius2(pts, i0, i1, i)
         if r < best or (r == best and _first(pts, i, i2)):
             best, i2 = r, i
     if i2 < 0:
         return None
-    if _orient(pts, i0, i1, i2) < 0.0:
+    if orient(pts, i0, i1, i2) < 0.0:
         i1, i2 = i2, i1
     # the seed circle's centre
     ax, ay = pts[i0, 0], pts[i0, 1]
@@ -267,7 +267,7 @@ def delaunay_triangles(pts, tol_area, tol_circle):
         e = start
         while True:
             q = hull_next[e]
-            if _orient(pts, e, q, i) < -tol_area:
+            if orient(pts, e, q, i) < -tol_area:
                 break
             e = q
             if e == start:
@@ -291,7 +291,7 @@ def delaunay_triangles(pts, tol_area, tol_circle):
         m = hull_next[e]
         while True:
             q = hull_next[m]
-            if not _orient(pts, m, q, i) < -tol_area:
+            if not orient(pts, m, q, i) < -tol_area:
                 break
             t = nt
             tris[t], tris[t + 1], tris[t + 2] = m, i, q
@@ -310,7 +310,7 @@ def delaunay_triangles(pts, tol_area, tol_circle):
         # backward likewise
         while True:
             q = hull_prev[e]
-            if not _orient(pts, q, e, i) < -tol_area:
+            if not orient(pts, q, e, i) < -tol_area:
                 break
             t = nt
             tris[t], tris[t + 1], tris[t + 2] = q, i, e

@@ -20,7 +20,7 @@ import numpy as np
 
 from sr33.jit import njit
 
-from ._delaunay_kernels import delaunay_triangles
+from ._delaunay_kernels import delaunay_triangles, orient
 from ._line_kernels import (
     TWO_PI,
     clamp,
@@ -259,11 +259,7 @@ def _smallest_area(pts, tri):
     """Twice the smallest triangle's area (``repair._doubled_areas``)."""
     out = np.inf
     for t in range(tri.shape[0]):
-        a, b, c = tri[t, 0], tri[t, 1], tri[t, 2]
-        area = (pts[b, 0] - pts[a, 0]) * (pts[c, 1] - pts[a, 1]) - (pts[b, 1] - pts[a, 1]) * (
-            pts[c, 0] - pts[a, 0]
-        )
-        out = min(out, abs(area))
+        out = min(out, abs(orient(pts, tri[t, 0], tri[t, 1], tri[t, 2])))
     return out
 
 

@@ -978,27 +978,30 @@ def _attempts(start: _Problem, first, descent_steps: int, max_edits: int, shakes
     is below ``GOOD_ENOUGH``, or after ``ATTEMPTS`` - 1 of each kind."""
     nbad, _, _, worst = _status(start)
     best = min((first, (start, nbad, worst)), key=_rank)
+    base, places, near = None, [], None  # the best answer's stuck places, while it is best
     for attempt in range(shakes_from, shakes_from + ATTEMPTS - 1):
         for local in (True, False):
             if best[2] < GOOD_ENOUGH:
                 break
             if local:
-                base = best[0]
-                bad = _status(base)[2]
-                if not bad[0].shape[0]:
+                if best[0] is not base:
+                    base = best[0]
+                    bad = _status(base)[2]
+                    places = [c for _, c in _regions(base, bad, set(), spread=0.5 * LOCAL_REACH)]
+                    near = _union(base, places, LOCAL_REACH)[0] if places else None
+                if not places:
                     continue
-                centres = [c for _, c in _regions(base, bad, set(), spread=0.5 * LOCAL_REACH)]
                 trial = base.copy()
-                _shake(trial, attempt, near=(centres, LOCAL_REACH * base.h))
+                _shake(trial, attempt, only=near)
             else:
-                centres = None
                 trial = start.copy()
                 _shake(trial, attempt)
+            centres = places if local else None
             answer = _search(trial, descent_steps, max_edits, STALL, centres=centres)
             log.debug(
                 "repair attempt %d %s: %d bad (worst %.3f)",
                 attempt,
-                "from the input" if centres is None else f"near {len(centres)} places",
+                f"near {len(places)} places" if local else "from the input",
                 answer[1],
                 answer[2],
             )
@@ -1013,17 +1016,15 @@ def _attempts(start: _Problem, first, descent_steps: int, max_edits: int, shakes
     return best
 
 
-def _shake(prob: _Problem, attempt: int, near=None) -> None:
+def _shake(prob: _Problem, attempt: int, only=None) -> None:
     """Move the free samples by the seeded offsets of ``attempt`` (uniform in
     a square of half-side 0.03 h times 1 to 5, ``attempt`` modulo 5: the
-    same on every machine); with ``near`` = (centres, radius) only those
-    within ``radius`` of a centre, by offsets of another seeded stream."""
-    rng = np.random.default_rng(attempt if near is None else (LOCAL_SEED, attempt))
+    same on every machine); with ``only`` (sample ids, ascending) those of
+    them only, by offsets of another seeded stream."""
+    rng = np.random.default_rng(attempt if only is None else (LOCAL_SEED, attempt))
     free = np.flatnonzero(prob.free)
-    if near is not None:
-        centres, radius = near
-        d = np.min([prob.distance(np.asarray(c)) for c in centres], axis=0)
-        free = free[d[free] < radius]
+    if only is not None:
+        free = np.intersect1d(free, only)
     size = 0.03 * ((attempt - 1) % 5 + 1) * prob.h
     prob.uv[free] += (rng.random((free.size, 2)) * 2.0 - 1.0) * size
     if prob.clamp is not None and free.size:
@@ -1410,8 +1411,9 @@ def anneal_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
     # the annealing moves samples and keeps them all: the origins stay
     was = np.where(out.origin >= 0, out.origin, n)
     movable_free = np.r_[free, True][was]
-    sliding = np.r_[slide & ~anchors, False][was]
+    slid = np.r_[slide, False][was]
     anchored = np.r_[anchors, False][was]
+    sliding = slid & ~anchored
     corners = _acute_corners(out.uv, sliding, anchored, h)
     bad = None  # the answer's triangles above BAD, made again once it changes
     for a, rays in corners:
@@ -1457,8 +1459,8 @@ def anneal_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
             trial_uv,
             movable_free,
             h,
-            slide=np.r_[slide, False][was],
-            anchors=np.r_[anchors, False][was],
+            slide=slid,
+            anchors=anchored,
             **judge_kw,
         )
         log.debug(

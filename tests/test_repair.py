@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial import Delaunay, cKDTree
 
+from sr33.mesh import triangle_ratios
 from sr33.samplers._anneal_kernels import corner_score
 from sr33.samplers.repair import (
     ANNEAL_REACH,
@@ -672,9 +673,7 @@ def _near_apex_worst(uv, inside, reach):
     tri = Delaunay(uv).simplices
     tri = tri[inside(uv[tri].mean(axis=1))]
     near = (np.linalg.norm(uv[tri], axis=2) < reach).any(axis=1)
-    p = uv[tri[near]]
-    e = np.sort(np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2), axis=1)
-    return float((e[:, 1] / e[:, 2]).max())
+    return float(triangle_ratios(uv, tri[near]).max())
 
 
 def test_anneal_corners_mends_an_acute_corner_the_descent_cannot():
@@ -726,9 +725,7 @@ def test_corner_score_is_the_worst_ratio_of_the_corners_delaunay_triangles():
     in_sector = (dirs[0, 0] * c[:, 1] - dirs[0, 1] * c[:, 0] > 0) & (
         c[:, 0] * dirs[1, 1] - c[:, 1] * dirs[1, 0] > 0
     )
-    p = pts[tri[(np.linalg.norm(c, axis=1) <= 4.0) & in_sector]]
-    e = np.sort(np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2), axis=1)
-    rho = e[:, 1] / e[:, 2]
+    rho = triangle_ratios(pts, tri[(np.linalg.norm(c, axis=1) <= 4.0) & in_sector])
     assert rho.size > 5
     assert score == pytest.approx(rho.max() + 0.2 * np.clip(rho - 0.8, 0, None).sum(), abs=1e-12)
     # the gaps on both rays: 1.0, 1.1, 0.9 of which none is out of bounds
