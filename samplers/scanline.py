@@ -496,6 +496,7 @@ def _sample_chain(
     ratio: float = 1.0,
     sphere=None,
     clear: float = 0.0,
+    cross=None,
 ) -> np.ndarray:
     """Samples along a chain of edges, about ``step`` apart.
 
@@ -510,7 +511,9 @@ def _sample_chain(
     its step), so that the row next to the edge does not stagger against
     the edge's samples (a star prism's sides, a wedge's slanted faces);
     its gaps at the row's ends are evened (:func:`_even_ends`, with
-    ``clear``).  An open section of a partial sphere (``sphere``, from
+    ``clear``).  Any other segment along no axis takes its face's lattice
+    across its rows where the face has one (``cross``, from
+    :func:`_cross_lattice`).  An open section of a partial sphere (``sphere``, from
     :func:`_sphere_frame`) is sampled by :func:`_sphere_row`.  Any other
     chain is sampled at equal arc-length steps from its start (for a closed
     section of a surface of revolution: from the seam, so rows line up too).
@@ -539,6 +542,9 @@ def _sample_chain(
                     anchor, es = par[int(np.argmin(off))]
                     step = ratio * es
                     aligned = False
+                elif cross is not None:
+                    rows, t0, step = cross
+                    anchor = t0 * rows
         c0 = float(dot(a - anchor, u))
         first = math.ceil(c0 / step - 1e-9)
         last = math.floor((c0 + length) / step + 1e-9)
@@ -674,17 +680,64 @@ def _drop_near_features(points, on_line, feature_curve, radius):
     return keep
 
 
-def _columns(face, d, hf, ratio, anchor, axis_steps):
-    """The planes through a planar face's columns, as :func:`_sample_chain`
-    places samples along its rows (normal, offset, spacing); None for a
-    curved face or one with a straight edge parallel to its rows (those
-    rows take that edge's samples as columns)."""
+def _row_direction(face, d) -> np.ndarray | None:
+    """The direction of a planar face's rows (its sections by the planes
+    normal to ``d``); None for a curved face or one the planes do not cut."""
     if face.geomType() != "PLANE":
         return None
     rows = np.cross(np.array(face.normalAt().toTuple()), d)
     if norm(rows) < 1e-9:
         return None
-    rows /= norm(rows)
+    return rows / norm(rows)
+
+
+def _cross_lattice(face, d, hf: float, ratio: float, anchor, tol: float):
+    """The lattice ``(rows, t0, step)`` (the rows' direction, the first
+    column's offset along it and the columns' spacing) along a planar face's rows when they run
+    along no coordinate axis, anchored on its straight edges across them
+    (perpendicular to the rows, in the face): None where there are none,
+    or where the default lattice (from the projection of ``anchor``,
+    ``ratio`` times ``hf``) holds them already, or no lattice holds them all
+    (:func:`_anchored`).
+
+    A row ending on such an edge was sampled from the shape's anchor, so
+    its last sample fell anywhere up to a step from the edge, and the one
+    within ``FEATURE_CLEARANCE`` h of it was dropped: a box's top edge
+    chamfered at 45° (a face whose rows run down its slope) kept a band of
+    rectangles 1.72 h across by 1 h along both of its long edges, ratio
+    0.864, and 271 of 5,966 samples broke III-ii by the geodesic check.
+    Anchored there, the rows divide the span between the edges into whole
+    steps, as :func:`_face_columns` does for rows along an axis."""
+    rows = _row_direction(face, d)
+    if rows is None or _axis_index(rows) is not None:
+        return None
+    off = []
+    for e in face.Edges():
+        if e.geomType() != "LINE":
+            continue
+        a = np.array(e.startPoint().toTuple())
+        t = np.array(e.endPoint().toTuple()) - a
+        if norm(t) > tol and abs(float(dot(t, rows))) <= 1e-9 * norm(t):
+            off.append(float(dot(a, rows)))
+    if not off:
+        return None
+    step = ratio * hf
+    default = float(dot(anchor, rows))
+    got = _anchored(np.array(sorted(off)), default, step, step, tol)
+    if got is None or got == (default, step):
+        return None
+    return rows, *got
+
+
+def _columns(face, d, hf, ratio, anchor, axis_steps, cross=None):
+    """The planes through a planar face's columns, as :func:`_sample_chain`
+    places samples along its rows (normal, offset, spacing); None for a
+    curved face or one with a straight edge parallel to its rows (those
+    rows take that edge's samples as columns).  ``cross`` is the face's
+    lattice along rows that run along no axis (:func:`_cross_lattice`)."""
+    rows = _row_direction(face, d)
+    if rows is None:
+        return None
     for e in face.Edges():
         if e.geomType() == "LINE":
             t = np.array(e.endPoint().toTuple()) - np.array(e.startPoint().toTuple())
@@ -695,6 +748,8 @@ def _columns(face, d, hf, ratio, anchor, axis_steps):
         axis = np.zeros(3)
         axis[k] = 1.0
         return axis, float(anchor[k]), float(axis_steps[k])
+    if cross is not None:
+        return cross
     return rows, float(dot(anchor, rows)), ratio * hf
 
 
@@ -1161,10 +1216,12 @@ def scan(
                 axis_steps[a] = ratio * hf
         _anchor_axes(faces, dirs, family, anchor, axis_steps, ratio, h, tol)
         columns = [_face_columns(f, anchor, axis_steps, ratio, h, tol) for f in faces]
+        crosses = []
         for fi, face in enumerate(faces):
             d = dirs[fam[fi]]
             t0, hf = aligned[fi]
-            planes.append((d, t0, hf, _columns(face, d, hf, ratio, *columns[fi])))
+            crosses.append(_cross_lattice(face, d, hf, ratio, columns[fi][0], tol))
+            planes.append((d, t0, hf, _columns(face, d, hf, ratio, *columns[fi], crosses[fi])))
         with timed("sample: feature samples"):
             chains = developable_bands(occ, size, sharp_degrees)
             edge_faces = EdgeFaces(occ)
@@ -1203,6 +1260,7 @@ def scan(
                         ratio,
                         sphere,
                         FEATURE_CLEARANCE * h,
+                        crosses[fi],
                     )
                     pts.extend(p)
                     fids.extend([fi] * len(p))

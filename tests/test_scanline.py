@@ -182,6 +182,44 @@ def test_rows_parallel_to_an_edge_start_on_it():
     assert abs(q - round(q)) > 0.1
 
 
+def _chamfered_box(d: float):
+    b = cq.Workplane().box(1.0, 0.8, 0.5)
+    top = [
+        e
+        for e in b.val().Edges()
+        if abs(e.Center().z - 0.25) < 1e-9 and abs(e.tangentAt(0.5).z) < 1e-9
+    ]
+    return cq.Solid(b.val().chamfer(d, None, top).wrapped)
+
+
+def test_rows_down_a_chamfers_slope_divide_it_between_its_long_edges():
+    """A 45° chamfer's rows run down its slope, along no axis: their samples
+    stand on a lattice anchored on the chamfer's long edges (across the
+    rows) that divides the span between them into whole steps
+    (:func:`sr33.samplers.scanline._cross_lattice`).  Anchored on the
+    bounding box, the last sample before each edge fell within the feature
+    clearance and was dropped, leaving rows 1.72 h from both edges
+    (rectangles of ratio 0.864; 271 of 5,966 samples broke III-ii)."""
+    solid = _chamfered_box(0.12)
+    r = scan(solid, target_points=6000, repair=False)
+    h = r.meta["spacing"]
+    slopes = [f for f in solid.Faces() if 0.5 < abs(f.normalAt().z) < 0.9]
+    assert len(slopes) == 4
+    for f in slopes:
+        n = np.array(f.normalAt().toTuple())
+        c = np.array(f.Center().toTuple())
+        down = np.cross(n, [0.0, 0.0, 1.0])
+        down = np.cross(n, down / np.linalg.norm(down))  # in the face, down its slope
+        on = np.abs((r.points - c) @ n) < 1e-9
+        levels = np.unique(np.round((r.points[on] - c) @ down / h, 6))
+        ends = np.array([(np.array(v.toTuple()) - c) @ down / h for v in f.Vertices()])
+        # the long edges' levels are sampled, and the rows' between them
+        np.testing.assert_allclose(levels[[0, -1]], [ends.min(), ends.max()], atol=1e-6)
+        gaps = np.diff(levels)
+        assert gaps.size >= 6
+        assert np.all((gaps > 0.9) & (gaps < 1.1)), gaps
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("sides", [6, 7])
 def test_regular_prisms_meet_condition_iii(sides):
