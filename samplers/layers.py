@@ -579,7 +579,8 @@ def repair_planar_faces(
         if squares == bool(arcs or any(not ln.square for ln in lines)):
             continue  # repaired in the other pass
         if not squares and lines:
-            # its square edges only where its rows run along no axis
+            # its square edges too where its rows run along no axis (two
+            # of the rows' components zero: along an axis)
             rows = np.cross(n, np.asarray(row_dirs[fi], dtype=np.float64))
             if np.sort(np.abs(rows))[1] <= 1e-9 * float(norm(rows)):
                 lines = [ln for ln in lines if not ln.square]

@@ -693,12 +693,12 @@ def _row_direction(face, d) -> np.ndarray | None:
 
 def _cross_lattice(face, d, hf: float, ratio: float, anchor, tol: float):
     """The lattice ``(rows, t0, step)`` (the rows' direction, the first
-    column's offset along it and the columns' spacing) along a planar face's rows when they run
-    along no coordinate axis, anchored on its straight edges across them
-    (perpendicular to the rows, in the face): None where there are none,
-    or where the default lattice (from the projection of ``anchor``,
-    ``ratio`` times ``hf``) holds them already, or no lattice holds them all
-    (:func:`_anchored`).
+    column's offset along it, the columns' spacing) along a planar face's
+    rows when they run along no coordinate axis, anchored on its straight
+    edges across them (perpendicular to the rows, in the face): None where
+    there are none, where the default lattice (from the projection of
+    ``anchor``, ``ratio`` times ``hf``) holds them already, or where no
+    lattice holds them all (:func:`_anchored`).
 
     A row ending on such an edge was sampled from the shape's anchor, so
     its last sample fell anywhere up to a step from the edge, and the one
@@ -711,14 +711,7 @@ def _cross_lattice(face, d, hf: float, ratio: float, anchor, tol: float):
     rows = _row_direction(face, d)
     if rows is None or _axis_index(rows) is not None:
         return None
-    off = []
-    for e in face.Edges():
-        if e.geomType() != "LINE":
-            continue
-        a = np.array(e.startPoint().toTuple())
-        t = np.array(e.endPoint().toTuple()) - a
-        if norm(t) > tol and abs(float(dot(t, rows))) <= 1e-9 * norm(t):
-            off.append(float(dot(a, rows)))
+    off = _parallel_edge_offsets(face, rows, tol)  # the edges normal to the rows
     if not off:
         return None
     step = ratio * hf

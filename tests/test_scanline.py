@@ -182,16 +182,6 @@ def test_rows_parallel_to_an_edge_start_on_it():
     assert abs(q - round(q)) > 0.1
 
 
-def _chamfered_box(d: float):
-    b = cq.Workplane().box(1.0, 0.8, 0.5)
-    top = [
-        e
-        for e in b.val().Edges()
-        if abs(e.Center().z - 0.25) < 1e-9 and abs(e.tangentAt(0.5).z) < 1e-9
-    ]
-    return cq.Solid(b.val().chamfer(d, None, top).wrapped)
-
-
 def test_rows_down_a_chamfers_slope_divide_it_between_its_long_edges():
     """A 45° chamfer's rows run down its slope, along no axis: their samples
     stand on a lattice anchored on the chamfer's long edges (across the
@@ -200,7 +190,7 @@ def test_rows_down_a_chamfers_slope_divide_it_between_its_long_edges():
     bounding box, the last sample before each edge fell within the feature
     clearance and was dropped, leaving rows 1.72 h from both edges
     (rectangles of ratio 0.864; 271 of 5,966 samples broke III-ii)."""
-    solid = _chamfered_box(0.12)
+    solid = cq.Workplane().box(1.0, 0.8, 0.5).edges(">Z").chamfer(0.12).val()
     r = scan(solid, target_points=6000, repair=False)
     h = r.meta["spacing"]
     slopes = [f for f in solid.Faces() if 0.5 < abs(f.normalAt().z) < 0.9]
