@@ -17,6 +17,11 @@ from scipy.spatial import cKDTree
 from sr33.mesh import dot, edge_uses, norm
 
 RIM_SAMPLED = 0.75  # an edge is sampled when a feature sample is this near its middle (times h)
+FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times h
+#: a planar face narrower than this (times h) along one of its straight
+#: edges holds no scan row: a strip, whose two long edges carry one set of
+#: samples across it (the scan rows' strip followers; the repair keeps them)
+STRIP_WIDTH = 2.0 * FEATURE_CLEARANCE
 
 
 def exact_bounds(shape) -> tuple[np.ndarray, np.ndarray]:

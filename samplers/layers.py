@@ -55,6 +55,7 @@ from .chart import (
 )
 from .disks import HALVE_GAP
 from .faces import (
+    STRIP_WIDTH,
     Stereographic,
     basis_surface,
     boundary_segments,
@@ -336,7 +337,12 @@ def _slanted_lines(
     holds the ends of that face's columns: where that face is a plain
     lattice (:func:`_plain_lattice`), its samples slide too (``follows``),
     and the columns follow them afterwards (:func:`_follow_columns`).  Any
-    other holds the ends of that face's rows or columns and stays."""
+    other holds the ends of that face's rows or columns and stays, as does
+    an edge of a strip (the other face narrower than ``STRIP_WIDTH`` h
+    along it), whose samples stand across from the strip's other edge's:
+    sliding, a polygon prism's cap moved them off, and a chamfer 1 h wide
+    kept 111 samples breaking III-ii, most along its edges (6 now, all at
+    the mitres' corners)."""
     n = np.array(face.normalAt().toTuple())
     faces = occ.Faces()
     out = []
@@ -387,10 +393,16 @@ def _slanted_lines(
             if mine.any():
                 d, _ = cKDTree(s.points[mine]).query(unfolded)
                 frame = frame[d > 0.5 * h]
-        slides = not square and _slanted(faces[fb], np.asarray(row_dirs[fb]), u)
+        # an edge of a strip (the other face narrower than STRIP_WIDTH along
+        # it): its samples stand across from the strip's other edge's and stay
+        corners = np.array([x.toTuple() for x in faces[fb].Vertices()]).reshape(-1, 3) - a3
+        across = np.linalg.norm(corners - dot(corners, u)[:, None] * u, axis=1)
+        strip = float(across.max()) < STRIP_WIDTH * h
+        slides = not square and not strip and _slanted(faces[fb], np.asarray(row_dirs[fb]), u)
         follows = (
             not square
             and not slides
+            and not strip
             and _parallel_rows(faces[fb], np.asarray(row_dirs[fb]), u)
             and _plain_lattice(faces[fb], np.asarray(row_dirs[fb]))
             and _step_fits(s, a3, u, length, h)

@@ -78,6 +78,8 @@ from sr33.progress import bar, log, timed
 from .adjacency import EdgeFaces
 from .bands import developable_bands
 from .faces import (
+    FEATURE_CLEARANCE,
+    STRIP_WIDTH,
     basis_surface,
     exact_bounds,
     goes_round,
@@ -92,7 +94,6 @@ from .frame import in_frame, model_frame
 
 AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 EDGE_STEP = 1.0  # spacing of corner/edge samples, times h
-FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times h
 #: the scan-line samples of two faces that meet where the surface folds back
 #: sharper than ``FOLDED`` degrees (an acute edge, a narrow slot) are thinned
 #: only this near each other (times h; any others at half a spacing): there
@@ -892,7 +893,7 @@ def _feature_samples(
     per_edge: dict[int, tuple[list[np.ndarray], int]] = {}  # edge -> its samples, face
     dense: list[tuple[float, float, float]] = [tuple(p) for p in vertex_pts]
     lattices: dict[int, list[tuple[np.ndarray, np.ndarray, float]]] = {}
-    follows = _strip_followers(ef, FEATURE_CLEARANCE * step * 2, tol, banded)
+    follows = _strip_followers(ef, STRIP_WIDTH * step, tol, banded)
     polygonal = [_polygonal(f) for f in faces]
     # an edge following another across a strip is sampled after it
     order = [i for i in range(len(ef.edges)) if i not in follows] + sorted(follows)
