@@ -49,6 +49,21 @@ def orient(pts, a, b, c):
 
 
 @njit(cache=True)
+def checkable(pts, tri, keep_area):
+    """Whether a triangulation of ``pts`` can be mended by edge flips at the
+    next step (kept for it, :func:`sr33.samplers._repair_kernels.delaunay_flips_since`):
+    every point a corner, and no triangle flat (twice its area at most
+    ``keep_area``)."""
+    used = np.zeros(pts.shape[0], dtype=np.bool_)
+    for t in range(tri.shape[0]):
+        for j in range(3):
+            used[tri[t, j]] = True
+        if abs(orient(pts, tri[t, 0], tri[t, 1], tri[t, 2])) <= keep_area:
+            return False
+    return used.all()
+
+
+@njit(cache=True)
 def _pseudo_angle(dx, dy):
     """A monotone stand-in for the angle of (dx, dy), in [0, 1)."""
     p = dx / (abs(dx) + abs(dy))

@@ -20,7 +20,7 @@ import numpy as np
 
 from sr33.jit import njit
 
-from ._delaunay_kernels import delaunay_triangles, orient
+from ._delaunay_kernels import checkable, delaunay_triangles
 from ._line_kernels import (
     TWO_PI,
     clamp,
@@ -255,15 +255,6 @@ def _clamped(q, parts, line_clamps, line_margins, arc_clamps):
 
 
 @njit(cache=True)
-def _smallest_area(pts, tri):
-    """Twice the smallest triangle's area (``repair._doubled_areas``)."""
-    out = np.inf
-    for t in range(tri.shape[0]):
-        out = min(out, abs(orient(pts, tri[t, 0], tri[t, 1], tri[t, 2])))
-    return out
-
-
-@njit(cache=True)
 def descend(
     uv,
     free,
@@ -379,7 +370,7 @@ def descend(
                 return QHULL, done, best, since, last_of, last_pts, last_tri, last_nbr, changed
             t0, n0 = swept
             tri, nbr = canonical_order(t0, n0)
-            if _smallest_area(pts, tri) > keep_area:
+            if checkable(pts, tri, keep_area):
                 last_of = of
             else:
                 last_of = np.empty(0, dtype=np.int64)

@@ -24,6 +24,30 @@ FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times 
 STRIP_WIDTH = 2.0 * FEATURE_CLEARANCE
 
 
+def axis_index(u: np.ndarray) -> int | None:
+    """Which coordinate axis the unit vector ``u`` runs along, if any."""
+    k = int(np.argmax(np.abs(u)))
+    return k if abs(abs(u[k]) - 1.0) < 1e-12 else None
+
+
+def row_direction(face, d) -> np.ndarray | None:
+    """The direction of a planar face's rows (its sections by the planes
+    normal to ``d``); None for a curved face or one the planes do not cut."""
+    if face.geomType() != "PLANE":
+        return None
+    rows = np.cross(np.array(face.normalAt().toTuple()), d)
+    if norm(rows) < 1e-9:
+        return None
+    return rows / norm(rows)
+
+
+def width_across(face, a: np.ndarray, u: np.ndarray) -> float:
+    """How far a face's corners reach from the line through ``a`` along the
+    unit vector ``u``: a strip's width along its edge there."""
+    q = np.array([v.toTuple() for v in face.Vertices()]).reshape(-1, 3) - a
+    return float(np.linalg.norm(q - dot(q, u)[:, None] * u, axis=1).max())
+
+
 def exact_bounds(shape) -> tuple[np.ndarray, np.ndarray]:
     """Bounding box from the exact geometry (CadQuery's uses any cached
     triangulation, which would make the scan planes depend on history)."""

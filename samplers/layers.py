@@ -57,6 +57,7 @@ from .disks import HALVE_GAP
 from .faces import (
     STRIP_WIDTH,
     Stereographic,
+    axis_index,
     basis_surface,
     boundary_segments,
     cap_rim,
@@ -65,8 +66,10 @@ from .faces import (
     perpendicular,
     revolution_axis,
     row_cosine,
+    row_direction,
     steps,
     whole_band,
+    width_across,
 )
 from .meridians import chained, plane_meridian, snapped
 from .repair import (
@@ -395,9 +398,7 @@ def _slanted_lines(
                 frame = frame[d > 0.5 * h]
         # an edge of a strip (the other face narrower than STRIP_WIDTH along
         # it): its samples stand across from the strip's other edge's and stay
-        corners = np.array([x.toTuple() for x in faces[fb].Vertices()]).reshape(-1, 3) - a3
-        across = np.linalg.norm(corners - dot(corners, u)[:, None] * u, axis=1)
-        strip = float(across.max()) < STRIP_WIDTH * h
+        strip = width_across(faces[fb], a3, u) < STRIP_WIDTH * h
         slides = not square and not strip and _slanted(faces[fb], np.asarray(row_dirs[fb]), u)
         follows = (
             not square
@@ -591,10 +592,10 @@ def repair_planar_faces(
         if squares == bool(arcs or any(not ln.square for ln in lines)):
             continue  # repaired in the other pass
         if not squares and lines:
-            # its square edges too where its rows run along no axis (two
-            # of the rows' components zero: along an axis)
-            rows = np.cross(n, np.asarray(row_dirs[fi], dtype=np.float64))
-            if np.sort(np.abs(rows))[1] <= 1e-9 * float(norm(rows)):
+            # its square edges too where its rows run along no axis (where
+            # the scan rows gave it a lattice across them of its own)
+            rows = row_direction(face, np.asarray(row_dirs[fi], dtype=np.float64))
+            if rows is None or axis_index(rows) is not None:
                 lines = [ln for ln in lines if not ln.square]
         on_plane = np.abs(dot(s.points - o, n)) < tol
         cand = np.flatnonzero(on_plane)

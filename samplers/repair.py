@@ -60,7 +60,7 @@ from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
 
 from ._anneal_kernels import FIXED, FREE, ON_EDGE, anneal_corner, corner_score
-from ._delaunay_kernels import delaunay_triangles
+from ._delaunay_kernels import checkable, delaunay_triangles
 from ._descent_kernels import QHULL, descend
 from ._repair_kernels import (
     canonical_order,
@@ -395,13 +395,11 @@ def _delaunay(prob: _Problem, pts: np.ndarray, of: np.ndarray) -> np.ndarray:
             prob.delaunay = None
             return np.empty((0, 3), dtype=np.int64)
         swept = _without_flat_hull(pts, d.simplices, d.neighbors, KEEP_AREA * h * h)
-    tri, nbr, smallest = canonical_triangles(pts, *swept)
-    # kept for the next step only when it can be checked there: every point
-    # a corner, no flat triangle
-    used = np.zeros(pts.shape[0], dtype=bool)
-    used[tri.ravel()] = True
-    kept = used.all() and smallest > KEEP_AREA * h * h
-    # (``pts`` and ``of`` are new arrays of every step's extended(): kept as they are)
+    tri, nbr = canonical_triangles(pts, *swept)
+    # kept for the next step only when it can be checked there (the fused
+    # descent keeps it by the same test); ``pts`` and ``of`` are new arrays
+    # of every step's extended(): kept as they are
+    kept = checkable(pts, tri, KEEP_AREA * h * h)
     prob.delaunay = (of, pts, tri, nbr) if kept else None
     return tri
 
@@ -443,16 +441,16 @@ def _without_flat_hull(pts: np.ndarray, simplices: np.ndarray, neighbors: np.nda
 def canonical_triangles(pts: np.ndarray, simplices: np.ndarray, neighbors: np.ndarray):
     """Triangles in one order whatever the triangulator's: each
     counter-clockwise from its smallest corner, the rows sorted; with the
-    neighbours opposite each corner (renumbered, -1 on the hull) and twice
-    the smallest triangle's area.  The repair's energy adds its terms in this
-    order, so that its bits depend on the triangles only."""
+    neighbours opposite each corner (renumbered, -1 on the hull).  The
+    repair's energy adds its terms in this order, so that its bits depend on
+    the triangles only."""
     tri = np.asarray(simplices, dtype=np.int64).copy()
     nbr = np.asarray(neighbors, dtype=np.int64).copy()
     area = _doubled_areas(pts, tri)
     cw = area < 0
     tri[cw] = tri[cw][:, [0, 2, 1]]
     nbr[cw] = nbr[cw][:, [0, 2, 1]]
-    return (*canonical_order(tri, nbr), float(np.abs(area).min()) if area.size else 0.0)
+    return canonical_order(tri, nbr)
 
 
 def _energy(prob: _Problem, subset=None, active=None, watch=None):

@@ -80,6 +80,7 @@ from .bands import developable_bands
 from .faces import (
     FEATURE_CLEARANCE,
     STRIP_WIDTH,
+    axis_index,
     basis_surface,
     exact_bounds,
     goes_round,
@@ -87,8 +88,10 @@ from .faces import (
     perpendicular,
     rims_sampled,
     row_cosine,
+    row_direction,
     steps,
     thin,
+    width_across,
 )
 from .frame import in_frame, model_frame
 
@@ -334,9 +337,7 @@ def _anchor_axes(faces, dirs, family, anchor, axis_steps, ratio: float, h: float
     lie on the default lattice already (boxes, models measured in round
     numbers) nothing changes.
     """
-    set_by_family = {
-        a for k in family if (a := _axis_index(dirs[k])) is not None and dirs[k][a] > 0
-    }
+    set_by_family = {a for k in family if (a := axis_index(dirs[k])) is not None and dirs[k][a] > 0}
     for a in range(3):
         if a in set_by_family:
             continue
@@ -461,12 +462,6 @@ def _chains(edges, tol: float) -> list[tuple[list[tuple[Any, bool]], bool]]:
     return chains
 
 
-def _axis_index(u: np.ndarray) -> int | None:
-    """Which coordinate axis the unit vector ``u`` runs along, if any."""
-    k = int(np.argmax(np.abs(u)))
-    return k if abs(abs(u[k]) - 1.0) < 1e-12 else None
-
-
 def _even_ends(s: np.ndarray, length: float, clear: float) -> np.ndarray:
     """Lattice positions on a segment ``[0, length]`` whose ends are sampled
     corners or edges: positions nearer than ``clear`` to an end are dropped
@@ -530,7 +525,7 @@ def _sample_chain(
             # a row along a coordinate axis steps like the planes across that
             # axis (the extent over a whole number of steps), so that its
             # samples meet the corner and edge samples of the faces it crosses
-            k = _axis_index(u)
+            k = axis_index(u)
             if k is not None:
                 step = float(axis_steps[k])
             else:
@@ -681,17 +676,6 @@ def _drop_near_features(points, on_line, feature_curve, radius):
     return keep
 
 
-def _row_direction(face, d) -> np.ndarray | None:
-    """The direction of a planar face's rows (its sections by the planes
-    normal to ``d``); None for a curved face or one the planes do not cut."""
-    if face.geomType() != "PLANE":
-        return None
-    rows = np.cross(np.array(face.normalAt().toTuple()), d)
-    if norm(rows) < 1e-9:
-        return None
-    return rows / norm(rows)
-
-
 def _cross_lattice(face, d, hf: float, ratio: float, anchor, tol: float):
     """The lattice ``(rows, t0, step)`` (the rows' direction, the first
     column's offset along it, the columns' spacing) along a planar face's
@@ -709,8 +693,8 @@ def _cross_lattice(face, d, hf: float, ratio: float, anchor, tol: float):
     0.864, and 271 of 5,966 samples broke III-ii by the geodesic check.
     Anchored there, the rows divide the span between the edges into whole
     steps, as :func:`_face_columns` does for rows along an axis."""
-    rows = _row_direction(face, d)
-    if rows is None or _axis_index(rows) is not None:
+    rows = row_direction(face, d)
+    if rows is None or axis_index(rows) is not None:
         return None
     off = _parallel_edge_offsets(face, rows, tol)  # the edges normal to the rows
     if not off:
@@ -729,7 +713,7 @@ def _columns(face, d, hf, ratio, anchor, axis_steps, cross=None):
     curved face or one with a straight edge parallel to its rows (those
     rows take that edge's samples as columns).  ``cross`` is the face's
     lattice along rows that run along no axis (:func:`_cross_lattice`)."""
-    rows = _row_direction(face, d)
+    rows = row_direction(face, d)
     if rows is None:
         return None
     for e in face.Edges():
@@ -737,7 +721,7 @@ def _columns(face, d, hf, ratio, anchor, axis_steps, cross=None):
             t = np.array(e.endPoint().toTuple()) - np.array(e.startPoint().toTuple())
             if abs(abs(float(dot(t, rows))) - norm(t)) <= 1e-9 * norm(t):
                 return None
-    k = _axis_index(rows)
+    k = axis_index(rows)
     if k is not None:
         axis = np.zeros(3)
         axis[k] = 1.0
@@ -827,7 +811,7 @@ def _square_crossings(a, u, length, adjacent, faces, polygonal, planes, axes, st
         return None
     if not all(polygonal[fi] for fi in adjacent):
         return None  # a face with an arc: its repair slides the arc's samples, not these
-    k = _axis_index(u)
+    k = axis_index(u)
     for fi in adjacent:
         f = faces[fi]
         if f.geomType() != "PLANE":
@@ -985,12 +969,9 @@ def _strip_followers(ef: EdgeFaces, width: float, tol: float, banded=()) -> dict
         face = ef.faces[k]
         if face.geomType() != "PLANE" or len(mine) < 2 or k in banded:
             continue
-        corners = np.array([v.toTuple() for v in face.Vertices()]).reshape(-1, 3)
         for i, e1 in enumerate(mine):
             a1, u1, l1 = lines[e1]
-            q = corners - a1
-            off = np.linalg.norm(q - dot(q, u1)[:, None] * u1, axis=1)
-            if float(off.max()) >= width:
+            if width_across(face, a1, u1) >= width:
                 continue
             for e2 in mine[i + 1 :]:
                 a2, u2, l2 = lines[e2]
@@ -1204,7 +1185,7 @@ def scan(
         # (a direction along a negative axis keeps the box's corner and step)
         anchor = lo.copy()
         for k, (t0, hf) in family.items():
-            a = _axis_index(dirs[k])
+            a = axis_index(dirs[k])
             if a is not None and dirs[k][a] > 0:
                 anchor[a] = t0
                 axis_steps[a] = ratio * hf

@@ -117,7 +117,7 @@ def _canonical_delaunay(pts):
     from sr33.samplers.repair import canonical_triangles
 
     d = Delaunay(pts)
-    tri, nbr, _ = canonical_triangles(pts, d.simplices, d.neighbors)
+    tri, nbr = canonical_triangles(pts, d.simplices, d.neighbors)
     return tri, nbr
 
 
