@@ -122,7 +122,11 @@ def _arcs(face, to2d, across=()) -> list[Arc]:
     """The circular edges of a planar face.  ``across`` (its edges and the
     face on the other side, from :meth:`EdgeFaces.across`) tells which arcs bound
     a full cylinder: only their samples slide.  The cylinder is laid out
-    from its rims afterwards, column under column, whatever their gaps; a
+    from its rims afterwards, column under column, whatever their gaps
+    (a whole band only, :func:`sr33.samplers.faces.whole_band`: a cylinder
+    notched by a boolean, a hole through a bitten ball, is repaired in its
+    chart with its rims' samples fixed, and the plane's samples slid off
+    the arc's ends there, 8 of 10 on a hole's rim in a box's floor); a
     cone's rings shrink towards its apex and need an evenly spaced rim
     (sliding it opened the cone's reconstruction), and so do the partial
     surfaces left to the scan rows (measured: cone 5.1 % -> 2.2 % violating
@@ -132,7 +136,7 @@ def _arcs(face, to2d, across=()) -> list[Arc]:
         if e.geomType() != "CIRCLE":
             continue
         other, wall = next(((f, k) for x, f, k in across if x.isSame(e)), (None, -1))
-        slides = other is not None and other.geomType() == "CYLINDER" and goes_round(other)
+        slides = other is not None and other.geomType() == "CYLINDER" and whole_band(other)
         wall = wall if slides else -1
         c = to2d(np.array([e.arcCenter().toTuple()]))[0]
         r = float(e.radius())

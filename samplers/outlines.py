@@ -287,11 +287,21 @@ def _view(chart, tri3: np.ndarray, lines, h: float, inside=None, step=None) -> _
     return _View(chart, inside, Rims(lines, chart, inside, h), h if step is None else step)
 
 
-def _sphere_chart(face) -> _Sphere | None:
+def _sphere_chart(face) -> _Sphere:
     """A sphere face's stereographic map from the point opposite its
-    centre (None where the face has no centre off the sphere's)."""
+    centre; where the face's centre is the sphere's (a ball drilled
+    through, bitten on opposite sides alike), from the sphere's own pole
+    (its surface's axis): such a face reaches round too far for one map
+    and is laid as the whole ball (:func:`_bitten_ball`)."""
     got = face_pole(face)
-    return None if got is None else _Sphere(*got)
+    if got is not None:
+        return _Sphere(*got)
+    sph = basis_surface(face).Sphere()
+    return _Sphere(
+        np.array(sph.Location().Coord()),
+        float(sph.Radius()),
+        np.array(sph.Position().Direction().Coord()),
+    )
 
 
 def _cylinder(face):
@@ -476,29 +486,51 @@ def _off_rims(s: Samples, idx: np.ndarray, rims: np.ndarray, h: float) -> np.nda
     return ~s.on_feature[idx] | far
 
 
-def _bitten_ball(fi, face, chart, tri3, lines, s: Samples, h: float, tol: float, size: float):
-    """A sphere face too wide for one map (``chart``, centred on the face;
-    ``tri3`` its tessellation, ``lines`` its rims): a ball with a bite
-    taken out by a box or another ball.  Laid as the whole ball is
-    (:func:`sr33.samplers.layers.lattice_revolved_body`, rings with halving
-    columns between two poles) about the axis through the face's centre,
-    whose far pole lies in the bite, keeping the rings' samples on the face
-    and h / 2 off its rims; then its rims' boundary layer is repaired on the
-    stereographic map centred in the bite (the rims within ``BITE`` of its
-    centre, where the map's scale is at most 1 / cos²(BITE / 2)).  Returns
-    the report, or None where the face is not of that kind."""
-    import cadquery as cq
+def _bites(rims: list, lines: list[np.ndarray], centre: np.ndarray, tol: float):
+    """A sphere face's rims grouped into bites: edges that meet (an end of
+    one within ``tol`` of an end of another) are one bite's, whatever
+    curves they are.  Returns, per bite, its edges' indices (ascending) and
+    the unit direction from the sphere's centre to the bite's centre (the
+    mean of its rim points' directions); bites in the order of their first
+    edge."""
+    n = len(rims)
+    group = list(range(n))
 
-    centre, radius, axis = chart.centre, chart.radius, chart.pole
-    bite = _Sphere(centre, radius, -axis)  # projected from the face's centre
+    def root(i: int) -> int:
+        while group[i] != i:
+            group[i] = group[group[i]]
+            i = group[i]
+        return i
+
+    ends = np.array([[q[0], q[-1]] for q in lines]).reshape(-1, 3)
+    for a, b in cKDTree(ends).query_pairs(tol):
+        ra, rb = root(a // 2), root(b // 2)
+        if ra != rb:
+            group[max(ra, rb)] = min(ra, rb)
+    out = []
+    for g in sorted({root(i) for i in range(n)}):
+        members = [i for i in range(n) if root(i) == g]
+        d = np.vstack([lines[i] for i in members]) - centre
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        mean = d.mean(axis=0)
+        out.append((members, mean / max(float(np.linalg.norm(mean)), 1e-300)))
+    return out
+
+
+def _bite_map(centre, radius: float, towards: np.ndarray, tri3, lines, h: float):
+    """The stereographic map centred in a bite (``towards``, the direction
+    from the sphere's centre to the bite's centre; projected from the point
+    opposite) with the face's inside there, filled in as far as 20° past
+    the bite's farthest rim point (beyond 10° past it, everything counts
+    as the face: the map runs to infinity at its centre of projection).
+    None where a rim point lies ``BITE`` or more from the bite's centre."""
+    bite = _Sphere(centre, radius, towards)
     rim_pts = np.vstack(lines)
-    rim_cos = dot(rim_pts - centre, -axis) / radius
+    rim_cos = dot(rim_pts - centre, towards) / radius
     if rim_cos.min() <= math.cos(BITE):
-        return None  # a rim far from the bite (two bites): not one map's
-    # the bite's map, filled in as far as 20° past the farthest rim: beyond
-    # 10° past it, all is the face (the map runs to infinity at its centre)
+        return None
     far = math.acos(max(-1.0, rim_cos.min()))
-    near = (dot(tri3.reshape(-1, 3) - centre, -axis).reshape(-1, 3) / radius) > math.cos(
+    near = (dot(tri3.reshape(-1, 3) - centre, towards).reshape(-1, 3) / radius) > math.cos(
         min(far + math.radians(20.0), math.pi * 0.95)
     )
     raster = TriangleRaster(
@@ -507,8 +539,53 @@ def _bitten_ball(fi, face, chart, tri3, lines, s: Samples, h: float, tol: float,
     beyond = 2.0 * radius * math.tan(min(far + math.radians(10.0), math.pi * 0.9) / 2.0)
 
     def inside(c: np.ndarray) -> np.ndarray:
-        # the map's centre of projection (the face's centre) maps to no point
+        # the map's centre of projection maps to no point
         return raster(c) | ~(np.linalg.norm(c, axis=1) <= beyond)
+
+    return bite, inside
+
+
+def _bitten_ball(fi, face, chart, tri3, lines, s: Samples, h: float, tol: float, size: float):
+    """A sphere face too wide for one map (``chart``, centred on the face;
+    ``tri3`` its tessellation, ``lines`` its rims): a ball with bites
+    taken out (by a box, another ball, a hole through it).  Laid as the
+    whole ball is (:func:`sr33.samplers.layers.lattice_revolved_body`, rings
+    with halving columns between two poles), keeping the rings' samples on
+    the face and h / 2 off its rims; then each bite's boundary layer is
+    repaired on the stereographic map centred in that bite (its rims within
+    ``BITE`` of its centre, where the map's scale is at most
+    1 / cos²(BITE / 2)).  The bites are the rims grouped where they meet
+    (:func:`_bites`).  With one bite, the rings' axis runs through the
+    face's centre (its far pole in the bite); with more, through the
+    widest bite (the one whose rims reach farthest from its centre), and
+    the others' repairs see the first ones' answers.  Returns the reports
+    (one per bite), or None where the face is not of that kind (a rim
+    ``BITE`` or more from its bite's centre)."""
+    import cadquery as cq
+
+    centre, radius = chart.centre, chart.radius
+    rims = rim_edges(face)
+    bites = _bites(rims, lines, centre, max(tol, 1e-3 * h))
+    if len(bites) == 1:
+        bites = [(bites[0][0], -chart.pole)]  # the face's centre opposite: as laid before
+    maps = []
+    for members, towards in bites:
+        got = _bite_map(centre, radius, towards, tri3, [lines[i] for i in members], h)
+        if got is None:
+            return None  # a rim far from its bite's centre: not one map's
+        maps.append((members, got[0], got[1]))
+
+    def reach(members, towards) -> float:
+        return float(-(dot(np.vstack([lines[i] for i in members]) - centre, towards)).max())
+
+    widest = min(range(len(bites)), key=lambda k: (reach(*bites[k]), k))
+    axis = -bites[widest][1]
+
+    def inside_all(p3: np.ndarray) -> np.ndarray:
+        ok = np.ones(p3.shape[0], dtype=bool)
+        for _, bite, inside in maps:
+            ok &= inside(bite(p3))
+        return ok
 
     ball = cq.Solid.makeSphere(
         radius, cq.Vector(*centre), cq.Vector(*axis), angleDegrees1=-90, angleDegrees2=90
@@ -522,16 +599,24 @@ def _bitten_ball(fi, face, chart, tri3, lines, s: Samples, h: float, tol: float,
         s,
         fi,
         on,
-        inside(bite(s.points[on])),
+        inside_all(s.points[on]),
         laid.points,
-        inside(bite(laid.points)),
+        inside_all(laid.points),
         np.maximum(laid.line_id, 0),
-        rim_pts,
+        np.vstack(lines),
         h,
     )
-    scale = float(np.median(bite.scale(bite(rim_pts))))
-    view = _view(bite, tri3, lines, h, inside=inside, step=h * scale)
-    return _repair_in(fi, face, view, s, h, tol, functools.partial(_layer, h=h), POLE_GOOD, False)
+    reports = []
+    for members, bite, inside in maps:
+        own = [lines[i] for i in members]
+        scale = float(np.median(bite.scale(bite(np.vstack(own)))))
+        view = _view(bite, tri3, own, h, inside=inside, step=h * scale)
+        rep = _repair_in(
+            fi, face, view, s, h, tol, functools.partial(_layer, h=h), POLE_GOOD, False
+        )
+        if rep is not None:
+            reports.append(rep)
+    return reports
 
 
 def _layer(c: np.ndarray, d: np.ndarray, *, h: float) -> np.ndarray:
@@ -610,8 +695,6 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
     wide = []
     for fi, face, lines in spheres:
         chart = _sphere_chart(face)
-        if chart is None:
-            continue
         tri3 = _face_triangles(face, h / 20)
         if dot(tri3.reshape(-1, 3) - chart.centre, chart.pole).min() <= REACH * chart.radius:
             wide.append((fi, face, chart, tri3, lines))  # too far round for one map
@@ -626,9 +709,7 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
         ]
         _lay_cylinder(fi, face, views[fi][0], lines, s, h, tol)
     for fi, face, chart, tri3, lines in wide:
-        rep = _bitten_ball(fi, face, chart, tri3, lines, s, h, tol, size)
-        if rep is not None:
-            reports.append(rep)
+        reports += _bitten_ball(fi, face, chart, tri3, lines, s, h, tol, size) or []
     layer = functools.partial(_layer, h=h)
     for _ in range(ROUNDS):
         for fi, face, _ in spheres:
