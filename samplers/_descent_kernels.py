@@ -206,24 +206,68 @@ def _scatter(uv, mask, values):
 
 
 @njit(cache=True)
-def _inside(c, kind, raster, raster_cell, sector):
+def _inside(c, kind, raster, raster_cell, sector, far):
     """Which points ``c`` are in the face: by its raster (``kind`` 0,
-    ``chart.Raster``) or in an annular sector (1: outer, inner, theta,
-    full; ``chart.Sector``)."""
+    ``chart.Raster``), in an annular sector (1: outer, inner, theta,
+    full; ``chart.Sector``), or by a raster of its triangles (2,
+    ``outlines.TriangleRaster``, ``far`` = (period, beyond): looked up
+    modulo the period along the first axis where it is positive, and
+    every point not within ``beyond`` of the origin inside too)."""
     if kind == 0:
         lo, grid = raster
         return grid_lookup(c, lo, raster_cell, grid)
+    if kind == 2:
+        lo, grid = raster
+        period, beyond = far
+        q = c.copy()
+        if period > 0.0:
+            for k in range(q.shape[0]):
+                q[k, 0] = q[k, 0] % period
+        out = grid_lookup(q, lo, raster_cell, grid)
+        if beyond < np.inf:
+            for k in range(c.shape[0]):
+                if not (np.sqrt(c[k, 0] * c[k, 0] + c[k, 1] * c[k, 1]) <= beyond):
+                    out[k] = True
+        return out
     outer, inner, theta, full = sector
     return inside_sector(c, outer, inner, theta, full)
 
 
 @njit(cache=True)
-def _clamped(q, parts, line_clamps, line_margins, arc_clamps):
+def _rim_clamped(q, rim, inside):
+    """``q`` kept in the face and off its rims (``outlines.RimClamp``):
+    ``rim`` = (points, inward normals, gaps); a point nearer its nearest
+    rim point than that point's gap, or outside (``inside``), goes to the
+    nearest rim point's inward normal at the gap.  The nearest rim point
+    by all of them, the first of equally near ones."""
+    c, inward, gap = rim
+    out = q.copy()
+    for k in range(q.shape[0]):
+        best, j = np.inf, -1
+        for m in range(c.shape[0]):
+            dx = q[k, 0] - c[m, 0]
+            dy = q[k, 1] - c[m, 1]
+            d = dx * dx + dy * dy
+            if d < best:
+                best, j = d, m
+        if j < 0:
+            continue
+        if np.sqrt(best) < gap[j] or not inside[k]:
+            out[k, 0] = c[j, 0] + gap[j] * inward[j, 0]
+            out[k, 1] = c[j, 1] + gap[j] * inward[j, 1]
+    return out
+
+
+@njit(cache=True)
+def _clamped(q, parts, line_clamps, line_margins, arc_clamps, rim, inside_of):
     """``q`` through every clamp of ``parts`` in order (rows: kind, first,
     end; kind 0 the straight edges ``line_clamps`` [first, end) with that
     part's (least, beyond) in ``line_margins``, kind 1 the arcs
     ``arc_clamps`` [first, end), kind 2 a distance from the origin within
-    that part's (lo, hi) in ``line_margins``, ``chart.RadialClamp``)."""
+    that part's (lo, hi) in ``line_margins``, ``chart.RadialClamp``; kind 3
+    the rims ``rim`` of :func:`_rim_clamped`, with ``inside_of`` = (kind,
+    raster, cell, sector, far) the face's inside test as :func:`_inside`
+    takes it)."""
     ca, cd, cdd, cn = line_clamps
     centre, radius, start, span, closed, side, margin = arc_clamps
     for k in range(parts.shape[0]):
@@ -240,6 +284,9 @@ def _clamped(q, parts, line_clamps, line_margins, arc_clamps):
             )
         elif parts[k, 0] == 2:
             q = clamp_radial(q, line_margins[k, 0], line_margins[k, 1])
+        elif parts[k, 0] == 3:
+            kind, raster, cell, sector, far = inside_of
+            q = _rim_clamped(q, rim, _inside(q, kind, raster, cell, sector, far))
         else:
             q = clamp_arcs(
                 q,
@@ -286,6 +333,8 @@ def descend(
     raster_cell,
     sector,
     glue,
+    far,
+    rim_clamp,
 ):
     """Up to ``steps`` steps of the repair's descent (``repair._steps``), in
     place on ``uv``, for a planar face bounded by straight edges and arcs.
@@ -300,7 +349,11 @@ def descend(
     straight edges (a, d, dd, inward, corners), h and kinds in order (see
     :func:`_ghost_points`); the inside test as :func:`_inside` takes it;
     ``glue`` = (turn, band, half, middle) of a development whose sides are
-    glued (turn 0: none; ``repair._Problem.images`` and ``wrap``).
+    glued (turn 0: none; ``repair._Problem.images`` and ``wrap``).  ``far``
+    = (period, beyond) of an inside test by a raster of triangles (kind 2,
+    see :func:`_inside`); ``rim_clamp`` = (points, inward normals, gaps)
+    of the rims a chart's clamp keeps free samples off (kind 3 of
+    :func:`_clamped`).
 
     A step whose points are not the last triangulation's (an edit added or
     removed a sample, one moved by more than the keep move) or whose flips
@@ -376,7 +429,7 @@ def descend(
                 last_of = np.empty(0, dtype=np.int64)
         last_pts, last_tri, last_nbr, changed = pts, tri, nbr, True
         # the face's triangles: inside it, or on its judged frame
-        inside = _inside(centroids(pts, tri), inside_kind, raster, raster_cell, sector)
+        inside = _inside(centroids(pts, tri), inside_kind, raster, raster_cell, sector, far)
         count = 0
         for t in range(tri.shape[0]):
             if not inside[t]:
@@ -433,7 +486,15 @@ def descend(
             _scatter(
                 uv,
                 shifted,
-                _clamped(_gather(uv, shifted), clamp_parts, line_clamps, line_margins, arc_clamps),
+                _clamped(
+                    _gather(uv, shifted),
+                    clamp_parts,
+                    line_clamps,
+                    line_margins,
+                    arc_clamps,
+                    rim_clamp,
+                    (inside_kind, raster, raster_cell, sector, far),
+                ),
             )
         if turn != 0.0:  # back into the sector
             for v in range(n):

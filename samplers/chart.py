@@ -417,3 +417,97 @@ def halving_count(x: float) -> int:
                 best = n
             n *= 2
     return best
+
+
+class TriangleRaster:
+    """Inside test of a domain given as triangles (``(t, 3, 2)``): the
+    cells of side ``cell`` whose centres lie in a triangle.  With
+    ``period``, the domain repeats along the first axis: a triangle across
+    ``[0, period)``'s ends is taken whole, and points are looked up modulo
+    the period.  With ``beyond``, every point not within that distance of
+    the origin is inside too (a map filled in only near its centre).  The
+    repair's descent kernel looks it up as it does
+    (``_descent_kernels._inside``, kind 2)."""
+
+    def __init__(
+        self, tri: np.ndarray, cell: float, period: float | None = None, beyond: float = math.inf
+    ):
+        self.beyond = float(beyond)
+        tri = np.asarray(tri, dtype=np.float64)
+        if period is not None:
+            x = tri[..., 0]
+            # a triangle across the cut has corners near both ends: lift the low ones
+            across = (x.max(axis=1) - x.min(axis=1)) > 0.5 * period
+            x[across] = np.where(x[across] < 0.5 * period, x[across] + period, x[across])
+            tri = np.concatenate([tri, tri - [period, 0.0]])
+        lo = tri.reshape(-1, 2).min(axis=0) - 2 * cell
+        hi = tri.reshape(-1, 2).max(axis=0) + 2 * cell
+        if period is not None:
+            lo[0], hi[0] = 0.0, period
+        self.lo, self.cell, self.period = lo, cell, period
+        nx, ny = (np.ceil((hi - lo) / cell).astype(int) + 1).tolist()
+        self.grid = np.zeros((ny, nx), dtype=bool)
+        i0 = np.ceil((tri.min(axis=1) - lo) / cell - 0.5).astype(np.int64)
+        i1 = np.floor((tri.max(axis=1) - lo) / cell - 0.5).astype(np.int64)
+        i0 = np.maximum(i0, 0)
+        i1 = np.minimum(i1, [nx - 1, ny - 1])
+        span = np.maximum(i1 - i0 + 1, 0)
+        counts = span[:, 0] * span[:, 1]
+        k = np.repeat(np.arange(tri.shape[0]), counts)
+        local = np.arange(k.size) - np.repeat(np.cumsum(counts) - counts, counts)
+        ix = i0[k, 0] + local % np.maximum(span[k, 0], 1)
+        iy = i0[k, 1] + local // np.maximum(span[k, 0], 1)
+        c = lo + (np.stack([ix, iy], axis=1) + 0.5) * cell
+        a, b, d = tri[k, 0], tri[k, 1], tri[k, 2]
+        den = (b[:, 0] - a[:, 0]) * (d[:, 1] - a[:, 1]) - (d[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+        ok = np.abs(den) > 0
+        den = np.where(ok, den, 1.0)
+        w1 = (
+            (c[:, 0] - a[:, 0]) * (d[:, 1] - a[:, 1]) - (d[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1])
+        ) / den
+        w2 = (
+            (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+        ) / den
+        eps = 1e-9
+        ok &= (w1 >= -eps) & (w2 >= -eps) & (w1 + w2 <= 1 + eps)
+        self.grid[iy[ok], ix[ok]] = True
+
+    def __call__(self, pts: np.ndarray) -> np.ndarray:
+        pts = given = np.asarray(pts, dtype=np.float64)
+        if self.period is not None:
+            pts = np.stack([pts[:, 0] % self.period, pts[:, 1]], axis=1)
+        ny, nx = self.grid.shape
+        cell = (pts - self.lo) / self.cell
+        ok = np.isfinite(cell).all(axis=1)
+        ok[ok] = (cell[ok] >= 0).all(axis=1) & (cell[ok, 0] < nx) & (cell[ok, 1] < ny)
+        ij = np.floor(cell[ok]).astype(np.int64)
+        out = np.zeros(pts.shape[0], dtype=bool)
+        out[ok] = self.grid[ij[:, 1], ij[:, 0]]
+        if self.beyond < math.inf:  # (NaN, a map's centre of projection, too)
+            out |= ~(np.linalg.norm(given, axis=1) <= self.beyond)
+        return out
+
+
+class RimClamp:
+    """A chart's clamp (:meth:`sr33.samplers.outlines.Rims.clamp`): rim
+    points ``c`` (in a k-d ``tree``) with the directions ``inward`` into
+    the face and the chart's ``scale`` there; a free sample nearer its
+    nearest rim point than ``margin`` times the chart's scale there, or
+    outside the face (``inside``), goes to that rim point's inward normal
+    at that distance.  ``gap`` per rim point, ``c`` and ``inward`` are what
+    the repair's descent kernel clamps by
+    (``_descent_kernels._rim_clamped``)."""
+
+    def __init__(self, c, inward, scale, tree: cKDTree, inside, margin: float):
+        self.c, self.inward, self.tree, self.inside = c, inward, tree, inside
+        self.gap = margin * scale
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        d, j = self.tree.query(p)
+        gap = self.gap[j]
+        bad = (d < gap) | ~self.inside(p)
+        if not bad.any():
+            return p
+        out = p.copy()
+        out[bad] = self.c[j[bad]] + gap[bad, None] * self.inward[j[bad]]
+        return out

@@ -48,6 +48,7 @@ from scipy.spatial import cKDTree
 from sr33 import libm
 from sr33.mesh import dot
 
+from .chart import RimClamp, TriangleRaster
 from .faces import RIM_SAMPLED, Stereographic, basis_surface, goes_round, steps
 from .layers import POLE_GOOD, RASTER, STUCK, lattice_revolved_body, unstuck
 from .repair import repair
@@ -127,67 +128,6 @@ class _Sphere(Stereographic):
         return 1.0 + (c**2).sum(axis=1) / (2.0 * self.radius) ** 2
 
 
-class TriangleRaster:
-    """Inside test of a domain given as triangles (``(t, 3, 2)``): the
-    cells of side ``cell`` whose centres lie in a triangle.  With
-    ``period``, the domain repeats along the first axis: a triangle across
-    ``[0, period)``'s ends is taken whole, and points are looked up modulo
-    the period."""
-
-    def __init__(self, tri: np.ndarray, cell: float, period: float | None = None):
-        tri = np.asarray(tri, dtype=np.float64)
-        if period is not None:
-            x = tri[..., 0]
-            # a triangle across the cut has corners near both ends: lift the low ones
-            across = (x.max(axis=1) - x.min(axis=1)) > 0.5 * period
-            x[across] = np.where(x[across] < 0.5 * period, x[across] + period, x[across])
-            tri = np.concatenate([tri, tri - [period, 0.0]])
-        lo = tri.reshape(-1, 2).min(axis=0) - 2 * cell
-        hi = tri.reshape(-1, 2).max(axis=0) + 2 * cell
-        if period is not None:
-            lo[0], hi[0] = 0.0, period
-        self.lo, self.cell, self.period = lo, cell, period
-        nx, ny = (np.ceil((hi - lo) / cell).astype(int) + 1).tolist()
-        self.grid = np.zeros((ny, nx), dtype=bool)
-        i0 = np.ceil((tri.min(axis=1) - lo) / cell - 0.5).astype(np.int64)
-        i1 = np.floor((tri.max(axis=1) - lo) / cell - 0.5).astype(np.int64)
-        i0 = np.maximum(i0, 0)
-        i1 = np.minimum(i1, [nx - 1, ny - 1])
-        span = np.maximum(i1 - i0 + 1, 0)
-        counts = span[:, 0] * span[:, 1]
-        k = np.repeat(np.arange(tri.shape[0]), counts)
-        local = np.arange(k.size) - np.repeat(np.cumsum(counts) - counts, counts)
-        ix = i0[k, 0] + local % np.maximum(span[k, 0], 1)
-        iy = i0[k, 1] + local // np.maximum(span[k, 0], 1)
-        c = lo + (np.stack([ix, iy], axis=1) + 0.5) * cell
-        a, b, d = tri[k, 0], tri[k, 1], tri[k, 2]
-        den = (b[:, 0] - a[:, 0]) * (d[:, 1] - a[:, 1]) - (d[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
-        ok = np.abs(den) > 0
-        den = np.where(ok, den, 1.0)
-        w1 = (
-            (c[:, 0] - a[:, 0]) * (d[:, 1] - a[:, 1]) - (d[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1])
-        ) / den
-        w2 = (
-            (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
-        ) / den
-        eps = 1e-9
-        ok &= (w1 >= -eps) & (w2 >= -eps) & (w1 + w2 <= 1 + eps)
-        self.grid[iy[ok], ix[ok]] = True
-
-    def __call__(self, pts: np.ndarray) -> np.ndarray:
-        pts = np.asarray(pts, dtype=np.float64)
-        if self.period is not None:
-            pts = np.stack([pts[:, 0] % self.period, pts[:, 1]], axis=1)
-        ny, nx = self.grid.shape
-        cell = (pts - self.lo) / self.cell
-        ok = np.isfinite(cell).all(axis=1)
-        ok[ok] = (cell[ok] >= 0).all(axis=1) & (cell[ok, 0] < nx) & (cell[ok, 1] < ny)
-        ij = np.floor(cell[ok]).astype(np.int64)
-        out = np.zeros(pts.shape[0], dtype=bool)
-        out[ok] = self.grid[ij[:, 1], ij[:, 0]]
-        return out
-
-
 def _face_triangles(face, tol: float) -> np.ndarray:
     """The face's own tessellation (tolerance ``tol``) as 3-D triangles ``(t, 3, 3)``."""
     verts, tris = face.tessellate(tol, 0.1)
@@ -238,22 +178,10 @@ class Rims:
         """Distance in space from each point to the rims (to ``RIM_STEP`` h)."""
         return self.tree3.query(x)[0]
 
-    def clamp(self, inside, margin: float):
+    def clamp(self, inside, margin: float) -> RimClamp:
         """Keep free samples in the face and ``margin`` (times the chart's
-        scale) from the rims: one too near, or outside, goes to its nearest
-        rim point's inward normal at that distance."""
-
-        def run(p: np.ndarray) -> np.ndarray:
-            d, j = self.tree2.query(p)
-            gap = margin * self.scale[j]
-            bad = (d < gap) | ~inside(p)
-            if not bad.any():
-                return p
-            out = p.copy()
-            out[bad] = self.c[j[bad]] + gap[bad, None] * self.inward[j[bad]]
-            return out
-
-        return run
+        scale) from the rims (:class:`RimClamp`)."""
+        return RimClamp(self.c, self.inward, self.scale, self.tree2, inside, margin)
 
     def unfold(self, x: np.ndarray, reach: float, clear: float) -> np.ndarray:
         """Points across the rims (in space) unfolded into the chart: each
@@ -533,15 +461,10 @@ def _bite_map(centre, radius: float, towards: np.ndarray, tri3, lines, h: float)
     near = (dot(tri3.reshape(-1, 3) - centre, towards).reshape(-1, 3) / radius) > math.cos(
         min(far + math.radians(20.0), math.pi * 0.95)
     )
-    raster = TriangleRaster(
-        bite(tri3[near.all(axis=1)].reshape(-1, 3)).reshape(-1, 3, 2), h / RASTER
-    )
     beyond = 2.0 * radius * math.tan(min(far + math.radians(10.0), math.pi * 0.9) / 2.0)
-
-    def inside(c: np.ndarray) -> np.ndarray:
-        # the map's centre of projection maps to no point
-        return raster(c) | ~(np.linalg.norm(c, axis=1) <= beyond)
-
+    inside = TriangleRaster(
+        bite(tri3[near.all(axis=1)].reshape(-1, 3)).reshape(-1, 3, 2), h / RASTER, beyond=beyond
+    )
     return bite, inside
 
 

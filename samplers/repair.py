@@ -83,7 +83,9 @@ from .chart import (
     LineProjection,
     RadialClamp,
     Raster,
+    RimClamp,
     Sector,
+    TriangleRaster,
 )
 
 TARGET = 0.78  # the descent pushes every ratio below this
@@ -550,7 +552,9 @@ def _kernel_form(prob: _Problem) -> dict | None:
     """A problem's callbacks as the arrays of
     :func:`sr33.samplers._descent_kernels.descend`, when every one is a
     form of :mod:`sr33.samplers.chart` (a planar face bounded by straight
-    edges and arcs, a disk's or a cone development's sector), else None."""
+    edges and arcs, a disk's or a cone development's sector, a curved face
+    in its chart: a raster of its triangles, a clamp off its rims), else
+    None."""
     parts = prob.clamp.parts if isinstance(prob.clamp, Chain) else (prob.clamp,)
     parts = tuple(c for c in parts if c is not None)
     ghosts = prob.ghosts.parts if isinstance(prob.ghosts, Joined) else (prob.ghosts,)
@@ -559,9 +563,11 @@ def _kernel_form(prob: _Problem) -> dict | None:
     if isinstance(p, LineProjection):
         p = CurveProjection.of_lines(p)
     if (
-        not isinstance(prob.inside, (Raster, Sector))
+        not isinstance(prob.inside, (Raster, Sector, TriangleRaster))
         or not (isinstance(p, CurveProjection) or (p is None and not prob.slide.any()))
-        or not all(isinstance(c, (LineClamp, ArcClamp, RadialClamp)) for c in parts)
+        or not all(isinstance(c, (LineClamp, ArcClamp, RadialClamp, RimClamp)) for c in parts)
+        or any(isinstance(c, RimClamp) and c.inside is not prob.inside for c in parts)
+        or sum(isinstance(c, RimClamp) for c in parts) > 1
         or not all(isinstance(g, (LineGhosts, ArcGhosts)) for g in ghosts)
         or sum(isinstance(g, LineGhosts) for g in ghosts) > 1
         or sum(isinstance(g, ArcGhosts) for g in ghosts) > 1
@@ -580,14 +586,20 @@ def _kernel_form(prob: _Problem) -> dict | None:
             kind, count = 0, c.a.shape[0]
         elif isinstance(c, ArcClamp):
             kind, count = 1, c.centre.shape[0]
+        elif isinstance(c, RimClamp):
+            kind, count = 3, 1
         else:
             kind, count = 2, 1
+        at.setdefault(type(c), 0)
         rows.append((kind, at[type(c)], at[type(c)] + count))
         at[type(c)] += count
 
     def stacked(of: list, name: str, empty: np.ndarray) -> np.ndarray:
         return np.ascontiguousarray(np.concatenate([getattr(c, name) for c in of]) if of else empty)
 
+    rim = next((c for c in parts if isinstance(c, RimClamp)), None)
+    gridded = isinstance(inside, (Raster, TriangleRaster))
+    period = getattr(inside, "period", None)
     line_ghosts = next((g for g in ghosts if isinstance(g, LineGhosts)), None)
     arc_ghosts = next((g for g in ghosts if isinstance(g, ArcGhosts)), None)
     return dict(
@@ -651,9 +663,23 @@ def _kernel_form(prob: _Problem) -> dict | None:
         ghost_kinds=np.array(
             [0 if isinstance(g, LineGhosts) else 1 for g in ghosts], dtype=np.int64
         ),
-        inside_kind=0 if isinstance(inside, Raster) else 1,
-        raster=(inside.lo, inside.grid) if isinstance(inside, Raster) else (none, no_grid),
-        raster_cell=float(inside.cell) if isinstance(inside, Raster) else 1.0,
+        inside_kind=0 if isinstance(inside, Raster) else 2 if gridded else 1,
+        raster=(inside.lo, inside.grid) if gridded else (none, no_grid),
+        raster_cell=float(inside.cell) if gridded else 1.0,
+        far=(
+            (float(period) if period is not None else 0.0, float(inside.beyond))
+            if isinstance(inside, TriangleRaster)
+            else (0.0, np.inf)
+        ),
+        rim_clamp=(
+            (
+                np.ascontiguousarray(rim.c, dtype=np.float64),
+                np.ascontiguousarray(rim.inward, dtype=np.float64),
+                np.ascontiguousarray(rim.gap, dtype=np.float64),
+            )
+            if rim is not None
+            else (none2, none2, none)
+        ),
         sector=(
             (float(inside.outer), float(inside.inner), float(inside.theta), bool(inside.full))
             if isinstance(inside, Sector)

@@ -629,6 +629,59 @@ def test_the_descent_in_one_kernel_turns_a_developments_images_as_the_python_loo
     assert_same_repair(fused, python)
 
 
+@pytest.mark.parametrize("period", [None, 40.0])
+def test_the_descent_in_one_kernel_keeps_a_charts_samples_off_its_rims_as_the_python_loop(
+    monkeypatch, period
+):
+    """A curved face in its chart (:mod:`sr33.samplers.outlines`): its
+    inside test a raster of its triangles (filled in beyond a radius, as a
+    bite's map is; looked up modulo a cylinder's period), its clamp the
+    rims' (the nearest rim point's inward normal at the gap).  The fused
+    descent gives the step-by-step loop's samples bit for bit."""
+    from scipy.spatial import Delaunay, cKDTree
+
+    from sr33.samplers.chart import RimClamp, TriangleRaster
+
+    rng = np.random.default_rng(65)
+    h, radius = 1.0, 3.3
+    g = np.stack(np.meshgrid(np.arange(-9.0, 10.0), np.arange(-9.0, 10.0)), -1).reshape(-1, 2)
+    g = g + rng.uniform(-0.2, 0.2, g.shape)
+    t = np.linspace(0.0, 2 * np.pi, int(2 * np.pi * radius * 20), endpoint=False)
+    rim = radius * np.stack([np.cos(t), np.sin(t)], 1)
+    k = int(round(2 * np.pi * radius / h))
+    on_rim = rim[:: len(t) // k][:k]
+    keep = np.linalg.norm(g, axis=1) > radius + 0.3 * h
+    uv = np.vstack([g[keep], on_rim])
+    dense = np.vstack(
+        [rim, np.stack(np.meshgrid(*[np.arange(-12.0, 12.5, 0.5)] * 2), -1).reshape(-1, 2)]
+    )
+    dense = dense[np.linalg.norm(dense, axis=1) >= radius - 1e-9]
+    tri = Delaunay(dense).simplices
+    tri = tri[np.linalg.norm(dense[tri].mean(axis=1), axis=1) > radius]
+    shift = np.array([20.0, 0.0]) if period is not None else np.zeros(2)
+    inside = TriangleRaster(dense[tri] + shift, h / 8, period, 11.0)
+    uv, rim = uv + shift, rim + shift
+    inward = (rim - shift) / radius
+    clamp = RimClamp(rim, inward, np.ones(len(rim)), cKDTree(rim), inside, 0.25 * h)
+    r = np.linalg.norm(uv - shift, axis=1)
+    free = np.r_[r[: keep.sum()] < radius + 3.0 * h, np.zeros(k, bool)]
+    args = dict(inside=inside, clamp=clamp, frame=np.empty((0, 2)))
+    calls = counted_steps(monkeypatch)
+    fused = repair(uv, free, h, **args)
+    assert sum(calls) > 20
+    calls.clear()
+    plain = {
+        **args,
+        "inside": plain_function(inside),
+        "clamp": RimClamp(
+            rim, inward, np.ones(len(rim)), cKDTree(rim), plain_function(inside), 0.25 * h
+        ),
+    }
+    python = repair(uv, free, h, **plain)
+    assert not calls
+    assert_same_repair(fused, python)
+
+
 def _acute_triangle(degrees: float, length: float):
     """An isosceles triangle with its apex of ``degrees`` at the origin and its
     base at x = ``length``, laid out as the scan lays a face: its edges

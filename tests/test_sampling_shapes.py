@@ -1673,7 +1673,8 @@ def test_an_unrolled_cylinder_is_an_isometry_and_its_raster_wraps():
     plane keeping lengths along it (arc length round, height along), and
     back; :class:`sr33.samplers.outlines.TriangleRaster` with its period
     takes a triangle across the cut whole, at both ends."""
-    from sr33.samplers.outlines import TriangleRaster, Unrolled
+    from sr33.samplers.chart import TriangleRaster
+    from sr33.samplers.outlines import Unrolled
 
     o = np.array([0.3, -0.2, 1.0])
     ez = np.array([0.0, 0.6, 0.8])
