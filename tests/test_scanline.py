@@ -210,6 +210,64 @@ def test_rows_down_a_chamfers_slope_divide_it_between_its_long_edges():
         assert np.all((gaps > 0.9) & (gaps < 1.1)), gaps
 
 
+def _chamfered_prism():
+    """The stop 61 survey's chamfer model: a prism over 4 corners,
+    0.568 high, its top edges chamfered 0.042, turned upside down."""
+    from tests.strategies import moved
+
+    pts = [
+        (0.5689581110276988, -0.2883166436340236),
+        (-0.02003503742544976, 0.6375252280309829),
+        (-0.6378399635493184, 7.811286697289372e-17),
+        (0.003593601166018955, -0.6378298402640435),
+    ]
+    height = 0.5681219105962784
+    solid = cq.Workplane().polyline(pts).close().extrude(height).val()
+    top = solid.BoundingBox().zmax
+    edges = [
+        e
+        for e in solid.Edges()
+        if abs(e.Center().z - top) < 1e-6 and abs(e.tangentAt(0.5).z) < 1e-6
+    ]
+    solid = cq.Solid(solid.chamfer(0.04229502170622691, None, edges).Solids()[0].wrapped)
+    return moved(solid, [-6.103515625e-05, 179.99999999999997, 1e-300], [0.0, 0.0, 0.0])
+
+
+def test_a_prisms_side_takes_one_lattice_between_its_edges():
+    """A prism's side runs its rows along its two long edges and takes its
+    columns from their samples (:func:`sr33.samplers.scanline._sample_chain`).
+    The edge against the chamfer holds the chamfer's row crossings (1.03 h
+    apart, 3,000 samples), the base's edge its own equal steps (0.99 h):
+    each row took the nearer edge's, and the columns broke off in the
+    middle row, where no repair reaches (20 samples at 0.87-0.89 on one
+    side).  Now the base's edge follows the chamfer's across the side
+    (:func:`sr33.samplers.scanline._side_followers`), and where both edges
+    hold crossings every row takes the first's: every row of every side
+    stands on one lattice."""
+    solid = _chamfered_prism()
+    r = scan(solid, target_points=3000, repair=False)
+    h = r.meta["spacing"]
+    sides = [
+        (k, f) for k, f in enumerate(solid.Faces()) if abs(f.normalAt().z) < 1e-3 and f.Area() > 0.2
+    ]
+    assert len(sides) == 4
+    for k, f in sides:
+        n = np.array(f.normalAt().toTuple())
+        along = np.cross(n, [0.0, 0.0, 1.0])
+        along /= np.linalg.norm(along)
+        c = np.array(f.Center().toTuple())
+        q = r.points[np.abs((r.points - c) @ n) < 1e-9] - c
+        u, z = q @ along, q[:, 2]
+        levels, counts = np.unique(np.round(z / h, 2), return_counts=True)
+        levels = levels[counts > 5]  # the rows and the long edges (not the short edges' samples)
+        assert levels.size >= 12
+        # the columns of the row next to one long edge, against every other row's
+        cols = [np.sort(u[np.abs(z / h - level) < 0.02])[1:-1] for level in levels]
+        for row in cols[2:-1]:
+            d = np.abs(row[:, None] - cols[1][None, :]).min(axis=1) / h
+            assert np.all(d < 1e-3), (k, np.round(d.max(), 3))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("sides", [6, 7])
 def test_regular_prisms_meet_condition_iii(sides):
