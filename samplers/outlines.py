@@ -414,14 +414,14 @@ def _off_rims(s: Samples, idx: np.ndarray, rims: np.ndarray, h: float) -> np.nda
     return ~s.on_feature[idx] | far
 
 
-def _bites(rims: list, lines: list[np.ndarray], centre: np.ndarray, tol: float):
-    """A sphere face's rims grouped into bites: edges that meet (an end of
-    one within ``tol`` of an end of another) are one bite's, whatever
-    curves they are.  Returns, per bite, its edges' indices (ascending) and
-    the unit direction from the sphere's centre to the bite's centre (the
-    mean of its rim points' directions); bites in the order of their first
-    edge."""
-    n = len(rims)
+def _bites(lines: list[np.ndarray], centre: np.ndarray, tol: float):
+    """A sphere face's rims (``lines``: each edge as points along it)
+    grouped into bites: edges that meet (an end of one within ``tol`` of an
+    end of another) are one bite's, whatever curves they are.  Returns, per
+    bite, its edges' indices (ascending) and the unit direction from the
+    sphere's centre to the bite's centre (the mean of its rim points'
+    directions); bites in the order of their first edge."""
+    n = len(lines)
     group = list(range(n))
 
     def root(i: int) -> int:
@@ -487,8 +487,7 @@ def _bitten_ball(fi, face, chart, tri3, lines, s: Samples, h: float, tol: float,
     import cadquery as cq
 
     centre, radius = chart.centre, chart.radius
-    rims = rim_edges(face)
-    bites = _bites(rims, lines, centre, max(tol, 1e-3 * h))
+    bites = _bites(lines, centre, max(tol, 1e-3 * h))
     if len(bites) == 1:
         bites = [(bites[0][0], -chart.pole)]  # the face's centre opposite: as laid before
     maps = []
@@ -498,10 +497,12 @@ def _bitten_ball(fi, face, chart, tri3, lines, s: Samples, h: float, tol: float,
             return None  # a rim far from its bite's centre: not one map's
         maps.append((members, got[0], got[1]))
 
-    def reach(members, towards) -> float:
-        return float(-(dot(np.vstack([lines[i] for i in members]) - centre, towards)).max())
+    def nearest(members, towards) -> float:
+        # the cosine of the bite's farthest rim point from its centre
+        return float(dot(np.vstack([lines[i] for i in members]) - centre, towards).min())
 
-    widest = min(range(len(bites)), key=lambda k: (reach(*bites[k]), k))
+    # (cosines to 1e-6: bites alike, a drilled ball's two rims, go by their order)
+    widest = min(range(len(bites)), key=lambda k: (round(nearest(*bites[k]) / radius, 6), k))
     axis = -bites[widest][1]
 
     def inside_all(p3: np.ndarray) -> np.ndarray:

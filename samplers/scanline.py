@@ -999,7 +999,7 @@ def _strip_followers(ef: EdgeFaces, width: float, tol: float, banded=()) -> dict
 
 
 def _side_followers(
-    ef: EdgeFaces, planes, step: float, tol: float, banded=(), taken=()
+    ef: EdgeFaces, planes, step: float, tol: float, banded=(), taken: dict | None = None
 ) -> dict[int, int]:
     """Straight edges that follow another across a planar face whose rows
     run along both (edge index -> the edge it follows): where of two
@@ -1015,7 +1015,7 @@ def _side_followers(
     (following, or followed, across a strip) and faces in ``banded`` are
     left alone."""
     out: dict[int, int] = {}
-    busy = set(taken) | set(taken.values()) if isinstance(taken, dict) else set(taken)
+    busy = set(taken or {}) | set((taken or {}).values())
     lines: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
     for ei, e in enumerate(ef.edges):
         if e.geomType() == "LINE" and e.Length() > tol:

@@ -1771,7 +1771,7 @@ def test_a_balls_rims_group_into_bites_where_they_meet():
     (face,) = [f for f in solid.Faces() if f.geomType() == "SPHERE"]
     centre = np.array(face.Center().toTuple())  # the ball's centre: the face is symmetric
     rims = rim_edges(face)
-    got = _bites(rims, rim_lines(rims, 0.02), centre, 1e-6)
+    got = _bites(rim_lines(rims, 0.02), centre, 1e-6)
     assert [m for m, _ in got] == [[0], [1]]
     assert np.dot(got[0][1], got[1][1]) == pytest.approx(-1.0, abs=1e-6)
     ball = cq.Solid.makeSphere(0.5, angleDegrees1=-90, angleDegrees2=90)
@@ -1781,7 +1781,7 @@ def test_a_balls_rims_group_into_bites_where_they_meet():
     ]
     rims = rim_edges(face)
     assert len(rims) >= 3
-    got = _bites(rims, rim_lines(rims, 0.02), np.zeros(3), 1e-6)
+    got = _bites(rim_lines(rims, 0.02), np.zeros(3), 1e-6)
     assert [m for m, _ in got] == [list(range(len(rims)))]
     assert got[0][1][2] > 0.9  # towards the top, where the box bit
 
