@@ -110,6 +110,7 @@ FILL_RADIUS = 1.0  # gaps wider than this (times h) get extra samples
 #: triangles of ratio step / sqrt(step^2 + width^2), above 0.85 below 0.62
 STRIP_STAGGER = 0.65
 SLANT_STEP = 1.45  # slanted edges are sampled where rows cross them this close (times h)
+LEAST_SPAN = 0.75  # straight edges across a face's rows closer than this (times h) anchor no step
 RATIO_RANGE = (0.6, 1.7)  # inside (1/sqrt(3), sqrt(3)) = (0.577, 1.732) with margin
 
 
@@ -259,12 +260,16 @@ def _anchored(off: np.ndarray, t0: float, hf: float, h: float, tol: float):
     """A lattice of planes (first, spacing) holding every offset in ``off``
     (sorted): the default ``(t0, hf)`` when it does; else anchored on the
     least offset, its spacing the one nearest ``h`` dividing their span (the
-    default spacing when they coincide within ``tol``); None when no such
-    lattice holds them all."""
+    default spacing when they coincide within ``tol`` or lie within
+    ``LEAST_SPAN`` h: a chamfer's setback of 0.6 h made a cap's rows and
+    its edges' samples 0.6 h apart); None when no such lattice holds them
+    all."""
     if off.size == 0 or _on_lattice(off, t0, hf):
         return t0, hf
     span = float(off[-1] - off[0])
-    if span <= tol:
+    if span <= max(tol, LEAST_SPAN * h):
+        # edges within a sliver's width (a chamfer's setback) divide no
+        # span into steps near h: anchored on the first, default spacing
         return float(off[0]), hf
     hs = _dividing_step(span, h)
     return (float(off[0]), hs) if _on_lattice(off, float(off[0]), hs) else None

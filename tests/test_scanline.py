@@ -268,6 +268,43 @@ def test_a_prisms_side_takes_one_lattice_between_its_edges():
             assert np.all(d < 1e-3), (k, np.round(d.max(), 3))
 
 
+def test_a_chamfers_setback_sets_no_rows_spacing():
+    """A chamfer sets its cap's edges back by its size: 0.6 h on the seed
+    64 survey's pentagonal prism (chamfer 0.022, 3,000 samples).  Those
+    edges lie in planes across the cap's rows, and the lattice anchored on
+    them divided the 0.6 h between them into one step: the cap's rows, and
+    the samples along its sides' edges (the sides' columns), stood 0.6 h
+    apart, and 726 samples broke III-ii.  Edges closer than ``LEAST_SPAN``
+    h anchor no step (:func:`sr33.samplers.scanline._anchored`): no face's
+    samples stand much closer than h to their nearest neighbour."""
+    from tests.strategies import moved
+
+    pts = [
+        (0.5227438697946817, 0.11198080501979356),
+        (0.16520155284738997, 0.5084380995141996),
+        (-0.4325032803487288, 0.31423202667517686),
+        (-0.34564741962287193, -0.4078341763619749),
+        (0.16520155284738985, -0.5084380995141997),
+    ]
+    height = 0.7362912590080357
+    solid = cq.Workplane().polyline(pts).close().extrude(height).val()
+    top = solid.BoundingBox().zmax
+    edges = [
+        e
+        for e in solid.Edges()
+        if abs(e.Center().z - top) < 1e-6 and abs(e.tangentAt(0.5).z) < 1e-6
+    ]
+    solid = cq.Solid(solid.chamfer(0.022088737770241073, None, edges).Solids()[0].wrapped)
+    solid = moved(solid, [0.0, -87.96293099179188, 74.73552812761872], [0.0, 0.0, 0.0])
+    r = scan(solid, target_points=3000, repair=False)
+    h = r.meta["spacing"]
+    d = cKDTree(r.points).query(r.points, 2)[0][:, 1] / h
+    for k, f in enumerate(solid.Faces()):
+        mine = (r.face_id == k) & ~r.on_feature
+        if f.Area() > 0.3 and mine.sum() > 50:
+            assert np.median(d[mine]) > 0.9, (k, np.median(d[mine]))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("sides", [6, 7])
 def test_regular_prisms_meet_condition_iii(sides):
