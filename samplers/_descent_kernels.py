@@ -208,15 +208,12 @@ def _scatter(uv, mask, values):
 @njit(cache=True)
 def _inside(c, kind, raster, raster_cell, sector, far):
     """Which points ``c`` are in the face: by its raster (``kind`` 0,
-    ``chart.Raster``), in an annular sector (1: outer, inner, theta,
-    full; ``chart.Sector``), or by a raster of its triangles (2,
-    ``outlines.TriangleRaster``, ``far`` = (period, beyond): looked up
-    modulo the period along the first axis where it is positive, and
-    every point not within ``beyond`` of the origin inside too)."""
+    ``chart.Raster``, or ``chart.TriangleRaster`` with ``far`` = (period,
+    beyond): looked up modulo the period along the first axis where it is
+    positive, and every point not within ``beyond`` of the origin inside
+    too; (0, inf) for a plain raster) or in an annular sector (1: outer,
+    inner, theta, full; ``chart.Sector``)."""
     if kind == 0:
-        lo, grid = raster
-        return grid_lookup(c, lo, raster_cell, grid)
-    if kind == 2:
         lo, grid = raster
         period, beyond = far
         q = c.copy()
@@ -235,7 +232,7 @@ def _inside(c, kind, raster, raster_cell, sector, far):
 
 @njit(cache=True)
 def _rim_clamped(q, rim, inside):
-    """``q`` kept in the face and off its rims (``outlines.RimClamp``):
+    """``q`` kept in the face and off its rims (``chart.RimClamp``):
     ``rim`` = (points, inward normals, gaps); a point nearer its nearest
     rim point than that point's gap, or outside (``inside``), goes to the
     nearest rim point's inward normal at the gap.  The nearest rim point
@@ -350,8 +347,8 @@ def descend(
     :func:`_ghost_points`); the inside test as :func:`_inside` takes it;
     ``glue`` = (turn, band, half, middle) of a development whose sides are
     glued (turn 0: none; ``repair._Problem.images`` and ``wrap``).  ``far``
-    = (period, beyond) of an inside test by a raster of triangles (kind 2,
-    see :func:`_inside`); ``rim_clamp`` = (points, inward normals, gaps)
+    = (period, beyond) of a raster's inside test (see :func:`_inside`);
+    ``rim_clamp`` = (points, inward normals, gaps)
     of the rims a chart's clamp keeps free samples off (kind 3 of
     :func:`_clamped`).
 

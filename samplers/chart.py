@@ -427,7 +427,7 @@ class TriangleRaster:
     the period.  With ``beyond``, every point not within that distance of
     the origin is inside too (a map filled in only near its centre).  The
     repair's descent kernel looks it up as it does
-    (``_descent_kernels._inside``, kind 2)."""
+    (``_descent_kernels._inside``, kind 0)."""
 
     def __init__(
         self, tri: np.ndarray, cell: float, period: float | None = None, beyond: float = math.inf
@@ -473,16 +473,10 @@ class TriangleRaster:
         self.grid[iy[ok], ix[ok]] = True
 
     def __call__(self, pts: np.ndarray) -> np.ndarray:
-        pts = given = np.asarray(pts, dtype=np.float64)
+        pts = given = as_points(pts)
         if self.period is not None:
-            pts = np.stack([pts[:, 0] % self.period, pts[:, 1]], axis=1)
-        ny, nx = self.grid.shape
-        cell = (pts - self.lo) / self.cell
-        ok = np.isfinite(cell).all(axis=1)
-        ok[ok] = (cell[ok] >= 0).all(axis=1) & (cell[ok, 0] < nx) & (cell[ok, 1] < ny)
-        ij = np.floor(cell[ok]).astype(np.int64)
-        out = np.zeros(pts.shape[0], dtype=bool)
-        out[ok] = self.grid[ij[:, 1], ij[:, 0]]
+            pts = np.ascontiguousarray(np.stack([pts[:, 0] % self.period, pts[:, 1]], axis=1))
+        out = grid_lookup(pts, self.lo, float(self.cell), self.grid)
         if self.beyond < math.inf:  # (NaN, a map's centre of projection, too)
             out |= ~(np.linalg.norm(given, axis=1) <= self.beyond)
         return out

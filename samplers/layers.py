@@ -588,19 +588,24 @@ def repair_planar_faces(
             continue
         seg = boundary_segments(face, to2d, h / 20)
         raster = Raster(seg, h / RASTER)
+        # the square edges in the first pass too where the face's rows run
+        # along no axis (where the scan rows gave it a lattice across them
+        # of its own)
+        rows = (
+            row_direction(face, np.asarray(row_dirs[fi], dtype=np.float64))
+            if row_dirs is not None
+            else None
+        )
+        no_axis = rows is not None and axis_index(rows) is None
         lines = (
-            _slanted_lines(occ, fi, face, to2d, row_dirs, s, raster, h, nbrs, squares=True)
+            _slanted_lines(
+                occ, fi, face, to2d, row_dirs, s, raster, h, nbrs, squares=squares or no_axis
+            )
             if row_dirs is not None
             else []
         )
         if squares == bool(arcs or any(not ln.square for ln in lines)):
             continue  # repaired in the other pass
-        if not squares and lines:
-            # its square edges too where its rows run along no axis (where
-            # the scan rows gave it a lattice across them of its own)
-            rows = row_direction(face, np.asarray(row_dirs[fi], dtype=np.float64))
-            if rows is None or axis_index(rows) is not None:
-                lines = [ln for ln in lines if not ln.square]
         on_plane = np.abs(dot(s.points - o, n)) < tol
         cand = np.flatnonzero(on_plane)
         uv = to2d(s.points[cand])

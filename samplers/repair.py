@@ -663,7 +663,7 @@ def _kernel_form(prob: _Problem) -> dict | None:
         ghost_kinds=np.array(
             [0 if isinstance(g, LineGhosts) else 1 for g in ghosts], dtype=np.int64
         ),
-        inside_kind=0 if isinstance(inside, Raster) else 2 if gridded else 1,
+        inside_kind=0 if gridded else 1,
         raster=(inside.lo, inside.grid) if gridded else (none, no_grid),
         raster_cell=float(inside.cell) if gridded else 1.0,
         far=(

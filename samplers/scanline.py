@@ -544,10 +544,13 @@ def _sample_chain(
                     if abs(abs(dot(eu, u)) - 1.0) < 1e-9
                 ]
                 if par:
-                    mid = (a + b) / 2
-                    off = [norm((mid - ea) - (dot(mid - ea, u)) * u) for ea, _, _ in par]
                     held = [i for i, x in enumerate(par) if x[2]]
-                    pick = held[0] if held else int(np.argmin(off))
+                    if held:
+                        pick = held[0]
+                    else:
+                        mid = (a + b) / 2
+                        off = [norm((mid - ea) - (dot(mid - ea, u)) * u) for ea, _, _ in par]
+                        pick = int(np.argmin(off))
                     anchor, es, _ = par[pick]
                     step = ratio * es
                     aligned = False
@@ -956,6 +959,22 @@ def _feature_samples(
     return pts, fid, np.array(dense, dtype=np.float64).reshape(-1, 3), lattices
 
 
+def _straight_edges(ef: EdgeFaces, tol: float):
+    """The shape's straight edges longer than ``tol`` (edge index -> start,
+    unit direction, length) and, per face, its straight edges' indices."""
+    lines: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
+    for ei, e in enumerate(ef.edges):
+        if e.geomType() == "LINE" and e.Length() > tol:
+            a = np.array(e.startPoint().toTuple())
+            b = np.array(e.endPoint().toTuple())
+            lines[ei] = (a, (b - a) / norm(b - a), float(norm(b - a)))
+    by_face: dict[int, list[int]] = {}
+    for ei in lines:
+        for k in ef.faces_of[ei]:
+            by_face.setdefault(k, []).append(ei)
+    return lines, by_face
+
+
 def _strip_followers(ef: EdgeFaces, width: float, tol: float, banded=()) -> dict[int, int]:
     """Straight edges that follow another across a narrow planar strip
     (edge index -> the edge it follows).
@@ -974,16 +993,7 @@ def _strip_followers(ef: EdgeFaces, width: float, tol: float, banded=()) -> dict
     had each end's edge follow its chamfer's other edge, half a step off
     the end's columns: 171 samples of each end at ratio 1.0)."""
     out: dict[int, int] = {}
-    lines: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
-    for ei, e in enumerate(ef.edges):
-        if e.geomType() == "LINE" and e.Length() > tol:
-            a = np.array(e.startPoint().toTuple())
-            b = np.array(e.endPoint().toTuple())
-            lines[ei] = (a, (b - a) / norm(b - a), float(norm(b - a)))
-    by_face: dict[int, list[int]] = {}
-    for ei in lines:
-        for k in ef.faces_of[ei]:
-            by_face.setdefault(k, []).append(ei)
+    lines, by_face = _straight_edges(ef, tol)
     for k, mine in sorted(by_face.items()):
         face = ef.faces[k]
         if face.geomType() != "PLANE" or len(mine) < 2 or k in banded:
@@ -1021,16 +1031,7 @@ def _side_followers(
     left alone."""
     out: dict[int, int] = {}
     busy = set(taken or {}) | set((taken or {}).values())
-    lines: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
-    for ei, e in enumerate(ef.edges):
-        if e.geomType() == "LINE" and e.Length() > tol:
-            a = np.array(e.startPoint().toTuple())
-            b = np.array(e.endPoint().toTuple())
-            lines[ei] = (a, (b - a) / norm(b - a), float(norm(b - a)))
-    by_face: dict[int, list[int]] = {}
-    for ei in lines:
-        for k in ef.faces_of[ei]:
-            by_face.setdefault(k, []).append(ei)
+    lines, by_face = _straight_edges(ef, tol)
     for k, mine in sorted(by_face.items()):
         face = ef.faces[k]
         if face.geomType() != "PLANE" or k in banded:

@@ -210,18 +210,12 @@ def test_rows_down_a_chamfers_slope_divide_it_between_its_long_edges():
         assert np.all((gaps > 0.9) & (gaps < 1.1)), gaps
 
 
-def _chamfered_prism():
-    """The stop 61 survey's chamfer model: a prism over 4 corners,
-    0.568 high, its top edges chamfered 0.042, turned upside down."""
+def _chamfered_prism(pts, height: float, size: float, turn):
+    """A prism over the polygon ``pts``, ``height`` high, its top edges
+    chamfered ``size``, turned by ``turn`` (degrees about x, y, z), as the
+    generated models' recipes build it."""
     from tests.strategies import moved
 
-    pts = [
-        (0.5689581110276988, -0.2883166436340236),
-        (-0.02003503742544976, 0.6375252280309829),
-        (-0.6378399635493184, 7.811286697289372e-17),
-        (0.003593601166018955, -0.6378298402640435),
-    ]
-    height = 0.5681219105962784
     solid = cq.Workplane().polyline(pts).close().extrude(height).val()
     top = solid.BoundingBox().zmax
     edges = [
@@ -229,8 +223,8 @@ def _chamfered_prism():
         for e in solid.Edges()
         if abs(e.Center().z - top) < 1e-6 and abs(e.tangentAt(0.5).z) < 1e-6
     ]
-    solid = cq.Solid(solid.chamfer(0.04229502170622691, None, edges).Solids()[0].wrapped)
-    return moved(solid, [-6.103515625e-05, 179.99999999999997, 1e-300], [0.0, 0.0, 0.0])
+    solid = cq.Solid(solid.chamfer(size, None, edges).Solids()[0].wrapped)
+    return moved(solid, turn, [0.0, 0.0, 0.0])
 
 
 def test_a_prisms_side_takes_one_lattice_between_its_edges():
@@ -243,8 +237,19 @@ def test_a_prisms_side_takes_one_lattice_between_its_edges():
     side).  Now the base's edge follows the chamfer's across the side
     (:func:`sr33.samplers.scanline._side_followers`), and where both edges
     hold crossings every row takes the first's: every row of every side
-    stands on one lattice."""
-    solid = _chamfered_prism()
+    stands on one lattice.  The model: the stop 61 survey's prism over 4
+    corners, chamfered 0.042, turned upside down."""
+    solid = _chamfered_prism(
+        [
+            (0.5689581110276988, -0.2883166436340236),
+            (-0.02003503742544976, 0.6375252280309829),
+            (-0.6378399635493184, 7.811286697289372e-17),
+            (0.003593601166018955, -0.6378298402640435),
+        ],
+        0.5681219105962784,
+        0.04229502170622691,
+        [-6.103515625e-05, 179.99999999999997, 1e-300],
+    )
     r = scan(solid, target_points=3000, repair=False)
     h = r.meta["spacing"]
     sides = [
@@ -277,25 +282,18 @@ def test_a_chamfers_setback_sets_no_rows_spacing():
     apart, and 726 samples broke III-ii.  Edges closer than ``LEAST_SPAN``
     h anchor no step (:func:`sr33.samplers.scanline._anchored`): no face's
     samples stand much closer than h to their nearest neighbour."""
-    from tests.strategies import moved
-
-    pts = [
-        (0.5227438697946817, 0.11198080501979356),
-        (0.16520155284738997, 0.5084380995141996),
-        (-0.4325032803487288, 0.31423202667517686),
-        (-0.34564741962287193, -0.4078341763619749),
-        (0.16520155284738985, -0.5084380995141997),
-    ]
-    height = 0.7362912590080357
-    solid = cq.Workplane().polyline(pts).close().extrude(height).val()
-    top = solid.BoundingBox().zmax
-    edges = [
-        e
-        for e in solid.Edges()
-        if abs(e.Center().z - top) < 1e-6 and abs(e.tangentAt(0.5).z) < 1e-6
-    ]
-    solid = cq.Solid(solid.chamfer(0.022088737770241073, None, edges).Solids()[0].wrapped)
-    solid = moved(solid, [0.0, -87.96293099179188, 74.73552812761872], [0.0, 0.0, 0.0])
+    solid = _chamfered_prism(
+        [
+            (0.5227438697946817, 0.11198080501979356),
+            (0.16520155284738997, 0.5084380995141996),
+            (-0.4325032803487288, 0.31423202667517686),
+            (-0.34564741962287193, -0.4078341763619749),
+            (0.16520155284738985, -0.5084380995141997),
+        ],
+        0.7362912590080357,
+        0.022088737770241073,
+        [0.0, -87.96293099179188, 74.73552812761872],
+    )
     r = scan(solid, target_points=3000, repair=False)
     h = r.meta["spacing"]
     d = cKDTree(r.points).query(r.points, 2)[0][:, 1] / h
