@@ -419,18 +419,32 @@ def halving_count(x: float) -> int:
     return best
 
 
+def _segment_gap(c: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance from each point ``c`` to the segment from ``a`` to ``b`` (row by row)."""
+    ab = b - a
+    t = np.clip(((c - a) * ab).sum(axis=1) / np.maximum((ab * ab).sum(axis=1), 1e-300), 0.0, 1.0)
+    return np.linalg.norm(c - a - t[:, None] * ab, axis=1)
+
+
 class TriangleRaster:
     """Inside test of a domain given as triangles (``(t, 3, 2)``): the
     cells of side ``cell`` whose centres lie in a triangle.  With
     ``period``, the domain repeats along the first axis: a triangle across
     ``[0, period)``'s ends is taken whole, and points are looked up modulo
     the period.  With ``beyond``, every point not within that distance of
-    the origin is inside too (a map filled in only near its centre).  The
-    repair's descent kernel looks it up as it does
-    (``_descent_kernels._inside``, kind 0)."""
+    the origin is inside too (a map filled in only near its centre).  With
+    ``grow``, a cell whose centre lies within that distance of a triangle
+    is inside too: a fan of slivers (a cone's tessellation round its apex,
+    thinner than a cell) leaves no holes.  The repair's descent kernel
+    looks it up as it does (``_descent_kernels._inside``, kind 0)."""
 
     def __init__(
-        self, tri: np.ndarray, cell: float, period: float | None = None, beyond: float = math.inf
+        self,
+        tri: np.ndarray,
+        cell: float,
+        period: float | None = None,
+        beyond: float = math.inf,
+        grow: float = 0.0,
     ):
         self.beyond = float(beyond)
         tri = np.asarray(tri, dtype=np.float64)
@@ -447,8 +461,8 @@ class TriangleRaster:
         self.lo, self.cell, self.period = lo, cell, period
         nx, ny = (np.ceil((hi - lo) / cell).astype(int) + 1).tolist()
         self.grid = np.zeros((ny, nx), dtype=bool)
-        i0 = np.ceil((tri.min(axis=1) - lo) / cell - 0.5).astype(np.int64)
-        i1 = np.floor((tri.max(axis=1) - lo) / cell - 0.5).astype(np.int64)
+        i0 = np.ceil((tri.min(axis=1) - grow - lo) / cell - 0.5).astype(np.int64)
+        i1 = np.floor((tri.max(axis=1) + grow - lo) / cell - 0.5).astype(np.int64)
         i0 = np.maximum(i0, 0)
         i1 = np.minimum(i1, [nx - 1, ny - 1])
         span = np.maximum(i1 - i0 + 1, 0)
@@ -470,6 +484,9 @@ class TriangleRaster:
         ) / den
         eps = 1e-9
         ok &= (w1 >= -eps) & (w2 >= -eps) & (w1 + w2 <= 1 + eps)
+        if grow > 0:
+            for p, q in ((a, b), (b, d), (d, a)):
+                ok |= _segment_gap(c, p, q) <= grow
         self.grid[iy[ok], ix[ok]] = True
 
     def __call__(self, pts: np.ndarray) -> np.ndarray:

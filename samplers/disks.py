@@ -48,6 +48,7 @@ from .chart import Sector, halving_count, radial_clamp
 from .faces import (
     cap_rim,
     goes_round,
+    linked_radii,
     linked_radius,
     perpendicular,
     steps,
@@ -202,7 +203,7 @@ def ring_plan(
     h: float,
     gap: float = HALVE_GAP,
     extra: int = 0,
-    count: int | None = None,
+    count: int | tuple[int | None, int | None] | None = None,
 ) -> tuple[float, list[tuple[float, int]]]:
     """Radial step and (radius, column count) of every ring, the rims included.
 
@@ -217,11 +218,16 @@ def ring_plan(
         this (times t).
     extra : int
         Rings added to the ``round(W / h)`` steps (a finer radial step).
-    count : int, optional
+    count : int or (int or None, int or None), optional
         A disk's rim count, of the form ``c 2^k`` (:func:`halving_count`),
         instead of its own ``halving_count(2 pi r / h)``: the count of a
         chain of rims it shares (:func:`sr33.samplers.faces.linked_radius`).
-        An annulus' counts start from its inner rim and ignore it.
+        An annulus' counts start from its inner rim, ``steps(2 pi r / h)``
+        by default; a pair gives its inner rim's count and its outer rim's
+        (that count times a power of two), each None for its own: the
+        counts of the chains its rims share (a tube chamfered at one end:
+        both ends' annuli take one count per chain, so that the chamfers'
+        bands have their columns on both circles).
 
     Returns
     -------
@@ -249,8 +255,12 @@ def ring_plan(
     rows = steps(outer - inner, h) + extra
     t = (outer - inner) / rows
     if inner > 0:
-        base = steps(2 * math.pi * inner, h, least=3)
-        top = max(0, math.floor(math.log2(2 * math.pi * outer / (gap * t * base))))
+        base_in, outer_count = count if isinstance(count, tuple) else (None, None)
+        base = base_in if base_in is not None else steps(2 * math.pi * inner, h, least=3)
+        if outer_count is not None:
+            top = round(math.log2(outer_count / base))
+        else:
+            top = max(0, math.floor(math.log2(2 * math.pi * outer / (gap * t * base))))
         nrings = rows + 1
     else:
         n = count if count is not None else halving_count(2 * math.pi * outer / h)
@@ -442,6 +452,48 @@ def _settle_cocircular(uv: np.ndarray, movable: np.ndarray, inside, clamp, t: fl
     return uv, moves
 
 
+def _annulus_counts(adjacency: EdgeFaces, rf: RoundFace, h: float, tol: float):
+    """An annulus' rim counts from the chains its rims share
+    (:func:`sr33.samplers.faces.linked_radii`), for :func:`ring_plan`, in
+    units of h: None where neither chain holds circles of two radii (its
+    own counts, as every annulus of such chains makes them alike), else
+    (inner, outer) such that every annulus on the chains gets the same:
+
+    * an inner chain of two radii: the inner count ``steps(2 pi R / h)`` of
+      its widest circle, the outer one that count times the power of two
+      whose gaps on the outer chain's widest circle are nearest above
+      ``HALVE_GAP`` h (None, its own, where the outer rim is chained to
+      nothing);
+    * else (an outer chain of two radii): the outer count
+      ``halving_count(2 pi R / h)`` of its widest circle, as a disk's, and
+      the inner one that count halved while its gaps on the inner rim stay
+      below ``HALVE_GAP`` h.
+
+    A cylinder with a hole, both chamfered at the top, whose top annulus
+    took its counts from its own radii (r - c and r' + c): 96 and 62
+    columns on the two circles of the outer chamfer's band, 24 and 31 on
+    the hole's, and 209 samples broke Condition III-ii; with its hole
+    chamfered wider than its counts link, the outer band kept 66 and 86
+    (153 samples).
+    """
+    inner = [round(r / h, 9) for r in linked_radii(adjacency, rf.index, rf.edges[-1], h)]
+    outer = [round(r / h, 9) for r in linked_radii(adjacency, rf.index, rf.edges[0], h)]
+    spread = tol / h
+    if max(inner) - min(inner) > spread:
+        base = steps(2 * math.pi * max(inner), 1.0, least=3)
+        if len(outer) == 1:
+            return base, None
+        level = max(0, math.floor(math.log2(2 * math.pi * max(outer) / (HALVE_GAP * base))))
+        return base, base << level
+    if max(outer) - min(outer) <= spread:
+        return None
+    top = halving_count(2 * math.pi * max(outer))
+    base = top
+    while base % 2 == 0 and base // 2 >= 3 and 2 * math.pi * inner[0] / base < HALVE_GAP:
+        base //= 2
+    return base, top
+
+
 def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dict], set[int]]:
     """Lay every disk and annulus of :func:`round_faces` out in rings.
 
@@ -475,9 +527,11 @@ def lattice_disk_faces(occ, s: Samples, h: float, size: float) -> tuple[list[dic
         if len(key) == 1:
             # a disk's rim takes the count of the widest circle chained to it
             # (a chamfer's cone band and the wall beyond carry its columns on)
-            chain = round(linked_radius(adjacency, rf.index, rf.edges[0]) / h, 9)
+            chain = round(linked_radius(adjacency, rf.index, rf.edges[0], h) / h, 9)
             if chain > key[0]:
                 count = halving_count(2 * math.pi * chain)
+        else:
+            count = _annulus_counts(adjacency, rf, h, tol)
         if (key, count) not in cache:
             cache[key, count] = _layout(key, 1.0, count)
         lay = cache[key, count]

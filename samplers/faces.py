@@ -248,6 +248,12 @@ def whole_band(face) -> bool:
 #: this share of the larger one's: with the larger circle's count, the
 #: smaller one's gaps stay within 20 % of the larger one's
 LINK_RATIO = 0.8
+#: ... or, whatever the ratio, when the band is narrower than this (times h):
+#: no row fits between its circles to change the count (a hole of radius
+#: 0.137 chamfered by 0.036, its circles 0.79 apart in ratio and 1.4 h apart
+#: on the cone, kept 24 columns below and 31 above, and every sample of the
+#: band broke Condition III-ii)
+LINK_WIDTH = 2.0
 
 
 def _other_circle(face, edge):
@@ -259,15 +265,16 @@ def _other_circle(face, edge):
     return None
 
 
-def linked_across(adjacency, fi: int, edge):
+def linked_across(adjacency, fi: int, edge, h: float | None = None):
     """The band across a circle edge of face ``fi`` that carries that
     circle's columns on to another circle: (the band's index, its other
     circle edge), or None.
 
     A band is a full cylinder, or a full cone between two whole circles
     (:func:`whole_band`) whose smaller radius is at least ``LINK_RATIO`` of
-    its larger one: a chamfer's cone between a cylinder's rim and the disk
-    it bevels.  Samples at the same angles on both circles make the band's
+    its larger one, or (given the spacing ``h``) whose circles lie less
+    than ``LINK_WIDTH`` h apart: a chamfer's cone between a cylinder's rim
+    and the disk it bevels.  Samples at the same angles on both circles make the band's
     cells rectangles however narrow the band is; two column counts make a
     band narrower than a row a strip of needle triangles (a cylinder of
     radius 0.33 chamfered by 0.05, its cone band's inner rim laid by the
@@ -284,23 +291,33 @@ def linked_across(adjacency, fi: int, edge):
         return None
     small, large = sorted((float(edge.radius()), float(far.radius())))
     if small < (LINK_RATIO - 1e-9) * large:
-        return None
+        width = norm(np.array(edge.Center().toTuple()) - np.array(far.Center().toTuple()))
+        if h is None or math.hypot(width, large - small) >= LINK_WIDTH * h:
+            return None
     return other, far
 
 
-def linked_radius(adjacency, fi: int, edge) -> float:
-    """The largest radius of the circles linked to ``edge`` (a circle edge
-    of face ``fi``) through bands (:func:`linked_across`), one after
-    another, ``edge``'s own included: the circle whose column count the
-    chain shares (a chamfered cylinder's two disks, of radii r and r - c,
-    both take the count of r, the wall's)."""
-    radius = float(edge.radius())
+def linked_radii(adjacency, fi: int, edge, h: float | None = None) -> list[float]:
+    """The radii of the circles linked to ``edge`` (a circle edge of face
+    ``fi``) through bands (:func:`linked_across`, with the spacing ``h``),
+    one after another, ``edge``'s own first: the circles that must carry
+    one column count."""
+    radii = [float(edge.radius())]
     seen = {fi}
-    while (step := linked_across(adjacency, fi, edge)) is not None and step[0] not in seen:
+    while (step := linked_across(adjacency, fi, edge, h)) is not None and step[0] not in seen:
         fi, edge = step
         seen.add(fi)
-        radius = max(radius, float(edge.radius()))
-    return radius
+        radii.append(float(edge.radius()))
+    return radii
+
+
+def linked_radius(adjacency, fi: int, edge, h: float | None = None) -> float:
+    """The largest radius of the circles linked to ``edge`` (a circle edge
+    of face ``fi``) through bands (:func:`linked_radii`), ``edge``'s own
+    included: the circle whose column count the chain shares (a chamfered
+    cylinder's two disks, of radii r and r - c, both take the count of r,
+    the wall's)."""
+    return max(linked_radii(adjacency, fi, edge, h))
 
 
 def revolution_axis(face):

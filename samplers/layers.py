@@ -905,7 +905,7 @@ def _full_turns(occ, kind: str):
             yield fi, face
 
 
-def _rim_sources(adjacency, fi: int, face, o, ez, vmin: float, vmax: float, tol: float):
+def _rim_sources(adjacency, fi: int, face, o, ez, vmin: float, vmax: float, h: float, tol: float):
     """What lies across each rim of a full cylinder: per side ("lo" at
     ``vmin``, "hi" at ``vmax``, along ``ez`` from ``o``), ``("plane",
     None)`` for a planar face (repaired or laid out already: its rim stays),
@@ -923,7 +923,7 @@ def _rim_sources(adjacency, fi: int, face, o, ez, vmin: float, vmax: float, tol:
         other = adjacency.other(e, fi)
         if side is None or other < 0:
             continue
-        band = linked_across(adjacency, fi, e)
+        band = linked_across(adjacency, fi, e, h)
         if adjacency.faces[other].geomType() == "PLANE":
             across[side] = ("plane", None)
         elif band is not None and adjacency.faces[band[0]].geomType() == "CONE":
@@ -988,7 +988,7 @@ def lattice_cylinder_faces(occ, s: Samples, h: float, size: float) -> list[dict]
         own = {side: _angles_about(q[idx[on]], ex, ey) for side, on in rims.items()}
         if min(a.size for a in own.values()) < 3:
             continue
-        sources = _rim_sources(adjacency, fi, face, o, ez, vmin, vmax, tol)
+        sources = _rim_sources(adjacency, fi, face, o, ez, vmin, vmax, h, tol)
         if not _same_angles(own["lo"], own["hi"]) and len(sources) < 2:
             continue  # an open end: the rims stay as the scan left them
         # the angles: a plane's rim, else a chamfer band's far circle, else the lower rim
@@ -1458,99 +1458,136 @@ def lattice_cone_faces(occ, s: Samples, h: float, size: float) -> list[dict]:
     tol = 1e-7 * size
     line = int(s.line_id.max()) + 1 if s.line_id.size else 0
     for fi, face in _full_turns(occ, "CONE"):
-        cone = basis_surface(face).Cone()
-        pos = cone.Position()
-        apex = np.array(cone.Apex().Coord())
-        loc = np.array(pos.Location().Coord())
-        if norm(loc - apex) < tol:
+        lay = lay_cone(fi, face, s, h, tol)
+        if lay is None:
             continue
-        corners = np.array([v.toTuple() for v in face.Vertices()], dtype=np.float64)
-        frustum = not (norm(corners.reshape(-1, 3) - apex) < tol).any()  # no vertex at its apex
-        axis = (loc - apex) / norm(loc - apex)
-        ex = np.array(pos.XDirection().Coord())
-        ey = np.cross(axis, ex)
-        tan_a = math.tan(abs(cone.SemiAngle()))
-        sin_a = math.sin(abs(cone.SemiAngle()))
-        cos_a = math.cos(abs(cone.SemiAngle()))
-        q = s.points - apex
-
-        along = dot(q, axis)
-        radial = np.linalg.norm(q - along[:, None] * axis, axis=1)
-        # on this face: on its cone and within its own extent along the axis
-        # (a boolean can leave two faces of one cone, a band between them cut
-        # away, and the rings of one must not run over the other's rim)
-        lo, hi = np.sort(_meridian(face, apex, axis, count=2)[1])
-        on = (
-            (np.abs(radial - along * tan_a) < tol * 10)
-            & (along > lo - tol * 10)
-            & (along < hi + tol * 10)
-        )
-        # the rim: feature samples of the face at its largest distance from the apex
-        cand = np.flatnonzero(on & (along > tol))
-        if cand.size == 0:
-            continue
-        top = along[cand].max()
-        rim = cand[s.on_feature[cand] & (np.abs(along[cand] - top) < tol * 10)]
-        if rim.size < 3:
-            continue  # the rim is a smooth edge (cone_tip): left to the scan rows
-        slant = top / cos_a
-        inner = None
-        if frustum:
-            # the small rim: the rings stop short of it, the band between is
-            # repaired with the rim's samples fixed (the rings must not run
-            # on to the apex, off the face)
-            bottom = along[cand].min()
-            low = cand[s.on_feature[cand] & (np.abs(along[cand] - bottom) < tol * 10)]
-            if low.size < 3:
-                continue
-            inner = (bottom / cos_a, _angles_about(q[low], ex, ey))
-        rows = steps(slant, h)
-        t = slant / rows
-        rim_ang = _angles_about(q[rim], ex, ey)
-        # rings halving by design from the rim to the apex's last rows (one
-        # step apart, ending columns by their gaps, repaired): the first of
-        # APEX_REACH rows, then one to two fewer, then more, that no halving
-        # has to be moved off its gap
-        meridian = (np.array([0.0, slant]), np.array([slant * sin_a, 0.0]))
-        reach, plan = _first_passing(
-            (APEX_REACH, APEX_REACH - 1, APEX_REACH - 2, APEX_REACH + 1),
-            lambda k, mer=meridian, t=t, m=rim_ang.size: ring_positions(*mer, t, m, keep=(1, k)),
-            lambda p: p.moved == 0,
-        )
-        # the rows near the apex end their columns by the first of
-        # APEX_END_LIMITS whose repaired rings meet APEX_GOOD by both
-        # measures round the apex (else the lowest by the smaller: the
-        # geodesic check's triangles there lie between the two measures)
-        args = (plan, reach, rim_ang, slant, sin_a, t, inner)
-        limits, got = _first_passing(
-            APEX_END_LIMITS,
-            lambda lim, args=args: _cone_rings(*args, lim),
-            lambda g: round(g.judged, 9) < APEX_GOOD,
-            rank=lambda g: round(g.lenient, 9),
-        )
-        rho_a, ang_a, row_a = got.rho, got.ang, got.row
-        nrows, bad, worst = got.rows, got.bad, got.worst
-        z = rho_a * cos_a
-        rr = rho_a * sin_a
-        new = (
-            apex
-            + z[:, None] * axis
-            + rr[:, None] * (np.cos(ang_a)[:, None] * ex + np.sin(ang_a)[:, None] * ey)
-        )
-        drop = cand[~s.on_feature[cand]]
         s.replace(
-            drop,
-            new,
-            np.where(row_a >= 0, line + row_a, -3),
-            np.full(new.shape[0], fi),
-            np.zeros(new.shape[0], dtype=bool),
+            lay.drop,
+            lay.points,
+            np.where(lay.rows >= 0, line + lay.rows, -3),
+            np.full(lay.points.shape[0], fi),
+            np.zeros(lay.points.shape[0], dtype=bool),
         )
-        line += nrows
-        report = {"face": fi, "kind": "cone rings", "rows": nrows, "samples": len(new)}
-        if bad is not None:
-            report.update(bad=bad, worst=worst, judged=got.judged, end_limits=limits)
-        reports.append(report)
+        line += lay.nrows
+        reports.append(lay.report)
     return reports
+
+
+@dataclass(frozen=True)
+class ConeLayout:
+    """A cone face's rings (:func:`lay_cone`): the laid points, their rows
+    (-1: added by the repair), the rows laid, the samples they replace and
+    the face's report."""
+
+    points: np.ndarray
+    rows: np.ndarray
+    nrows: int
+    drop: np.ndarray
+    report: dict
+
+
+def lay_cone(fi: int, face, s: Samples, h: float, tol: float, whole: bool = True):
+    """The rings of :func:`lattice_cone_faces` on cone face ``fi``
+    (Condition III-ii, Section 3), or None where its widest rim is not
+    sampled (a smooth edge) or the face has no extent.  ``whole=False``
+    lays a face that is no whole band (notched by a boolean) as its whole
+    cone, from its widest rim to the apex: the caller keeps the points
+    inside the face (:func:`sr33.samplers.outlines.repair_curved_faces`)."""
+    cone = basis_surface(face).Cone()
+    pos = cone.Position()
+    apex = np.array(cone.Apex().Coord())
+    loc = np.array(pos.Location().Coord())
+    if norm(loc - apex) < tol:
+        return None
+    corners = np.array([v.toTuple() for v in face.Vertices()], dtype=np.float64)
+    # no vertex at its apex (a notched cone is laid whole, to the apex)
+    frustum = whole and not (norm(corners.reshape(-1, 3) - apex) < tol).any()
+    axis = (loc - apex) / norm(loc - apex)
+    ex = np.array(pos.XDirection().Coord())
+    ey = np.cross(axis, ex)
+    tan_a = math.tan(abs(cone.SemiAngle()))
+    sin_a = math.sin(abs(cone.SemiAngle()))
+    cos_a = math.cos(abs(cone.SemiAngle()))
+    q = s.points - apex
+
+    along = dot(q, axis)
+    radial = np.linalg.norm(q - along[:, None] * axis, axis=1)
+    # on this face: on its cone and within its own extent along the axis
+    # (a boolean can leave two faces of one cone, a band between them cut
+    # away, and the rings of one must not run over the other's rim)
+    lo, hi = np.sort(_meridian(face, apex, axis, count=2)[1])
+    on = (
+        (np.abs(radial - along * tan_a) < tol * 10)
+        & (along > lo - tol * 10)
+        & (along < hi + tol * 10)
+    )
+    # the rim: feature samples of the face at its largest distance from the apex
+    cand = np.flatnonzero(on & (along > tol))
+    if cand.size == 0:
+        return None
+    top = along[cand].max()
+    rim = cand[s.on_feature[cand] & (np.abs(along[cand] - top) < tol * 10)]
+    if rim.size < 3:
+        return None  # the rim is a smooth edge (cone_tip): left to the scan rows
+    slant = top / cos_a
+    inner = None
+    if frustum:
+        # the small rim: the rings stop short of it, the band between is
+        # repaired with the rim's samples fixed (the rings must not run
+        # on to the apex, off the face)
+        bottom = along[cand].min()
+        low = cand[s.on_feature[cand] & (np.abs(along[cand] - bottom) < tol * 10)]
+        if low.size < 3:
+            return None
+        inner = (bottom / cos_a, _angles_about(q[low], ex, ey))
+    rim_ang = _angles_about(q[rim], ex, ey)
+    # the rings' step divides the slant to the apex into whole steps of
+    # about h; a frustum's band into steps of about its rim's gaps, so
+    # that a band a few rows wide gets near-square cells (a chamfer's
+    # band 1.6 h wide whose rims carry a hole's count, 1 h apart, kept
+    # no ring at a step of h, its ring 0.58 h from the small circle
+    # dropped: cells 1.6 h by 0.8 to 1 h, ratio 0.88; one 1.6 h wide
+    # under a wall's count, 1.28 h apart, got a ring at a step of h:
+    # cells 0.8 h by 1.28 h, ratio 0.86, and none by its gaps, 0.78)
+    if inner is None:
+        t = slant / steps(slant, h)
+    else:
+        span = slant - inner[0]
+        t = span / steps(span, 2.0 * math.pi * top * tan_a / rim_ang.size)
+    # rings halving by design from the rim to the apex's last rows (one
+    # step apart, ending columns by their gaps, repaired): the first of
+    # APEX_REACH rows, then one to two fewer, then more, that no halving
+    # has to be moved off its gap
+    meridian = (np.array([0.0, slant]), np.array([slant * sin_a, 0.0]))
+    reach, plan = _first_passing(
+        (APEX_REACH, APEX_REACH - 1, APEX_REACH - 2, APEX_REACH + 1),
+        lambda k, mer=meridian, t=t, m=rim_ang.size: ring_positions(*mer, t, m, keep=(1, k)),
+        lambda p: p.moved == 0,
+    )
+    # the rows near the apex end their columns by the first of
+    # APEX_END_LIMITS whose repaired rings meet APEX_GOOD by both
+    # measures round the apex (else the lowest by the smaller: the
+    # geodesic check's triangles there lie between the two measures)
+    args = (plan, reach, rim_ang, slant, sin_a, t, inner)
+    limits, got = _first_passing(
+        APEX_END_LIMITS,
+        lambda lim, args=args: _cone_rings(*args, lim),
+        lambda g: round(g.judged, 9) < APEX_GOOD,
+        rank=lambda g: round(g.lenient, 9),
+    )
+    rho_a, ang_a, row_a = got.rho, got.ang, got.row
+    nrows, bad, worst = got.rows, got.bad, got.worst
+    z = rho_a * cos_a
+    rr = rho_a * sin_a
+    new = (
+        apex
+        + z[:, None] * axis
+        + rr[:, None] * (np.cos(ang_a)[:, None] * ex + np.sin(ang_a)[:, None] * ey)
+    )
+    report = {"face": fi, "kind": "cone rings", "rows": nrows, "samples": len(new)}
+    if bad is not None:
+        report.update(bad=bad, worst=worst, judged=got.judged, end_limits=limits)
+    return ConeLayout(new, row_a, nrows, cand[~s.on_feature[cand]], report)
 
 
 APEX_KEEP = 5.0  # samples this near the apex (times t) stay

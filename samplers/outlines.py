@@ -49,8 +49,8 @@ from sr33 import libm
 from sr33.mesh import dot
 
 from .chart import RimClamp, TriangleRaster
-from .faces import RIM_SAMPLED, Stereographic, basis_surface, goes_round, steps
-from .layers import POLE_GOOD, RASTER, STUCK, lattice_revolved_body, unstuck
+from .faces import RIM_SAMPLED, Stereographic, basis_surface, goes_round, steps, whole_band
+from .layers import POLE_GOOD, RASTER, STUCK, lattice_revolved_body, lay_cone, unstuck
 from .repair import repair
 from .samples import Samples
 from .spheres import FACING, face_pole
@@ -113,6 +113,109 @@ class Unrolled:
     def scale(self, c: np.ndarray) -> np.ndarray:
         return np.ones(c.shape[0])
 
+    def triangles(self, tri3: np.ndarray) -> np.ndarray:
+        """A face's triangles ``(t, 3, 3)`` in the chart (across the cut as
+        :class:`sr33.samplers.chart.TriangleRaster` takes them, by its period)."""
+        return self(tri3.reshape(-1, 3)).reshape(-1, 3, 2)
+
+    def images(self, c: np.ndarray, reach: float) -> list[np.ndarray]:
+        """The chart points ``c`` within ``reach`` of the cut, carried across it."""
+        low, high = c[:, 0] < reach, c[:, 0] > self.period - reach
+        return [c[low] + [self.period, 0.0], c[high] - [self.period, 0.0]]
+
+    def from_cut(self, c: np.ndarray) -> np.ndarray:
+        """Distance in the chart from each point to the cut."""
+        return np.minimum(c[:, 0], self.period - c[:, 0])
+
+    def from_half_turn(self, c: np.ndarray) -> np.ndarray:
+        """Distance in the chart from each point to the line half a turn from the cut."""
+        return np.abs(c[:, 0] - 0.5 * self.period)
+
+
+class Developed:
+    """A cone developed from the angle ``cut``: a point at angle θ about the
+    axis (from ``ex`` towards ``ey``) and slant distance ρ from the apex
+    maps to ``ρ (cos φ, sin φ)``, ``φ = sin(a) ((θ - cut) mod 2π)``: an
+    isometry onto a sector of angle ``2π sin(a)`` (``sector``) about the
+    apex.  The cut's two sides are the sector's two rays; the chart has no
+    period (a turn is a rotation by ``sector``, not a translation)."""
+
+    period = None
+
+    def __init__(self, apex, axis, ex, ey, sin_a: float, cut: float):
+        self.apex, self.axis, self.ex, self.ey = apex, axis, ex, ey
+        self.sin_a, self.cos_a, self.cut = sin_a, math.sqrt(1.0 - sin_a * sin_a), cut
+        self.sector = 2.0 * math.pi * sin_a
+
+    def _polar(self, p) -> tuple[np.ndarray, np.ndarray]:
+        q = np.asarray(p, dtype=np.float64) - self.apex
+        ang = (libm.arctan2(dot(q, self.ey), dot(q, self.ex)) - self.cut) % (2.0 * math.pi)
+        return np.linalg.norm(q, axis=1), ang
+
+    def __call__(self, p) -> np.ndarray:
+        rho, ang = self._polar(p)
+        return _rotated(rho, self.sin_a * ang)
+
+    def inverse(self, c: np.ndarray) -> np.ndarray:
+        rho = np.hypot(c[:, 0], c[:, 1])
+        ang = self.cut + (libm.arctan2(c[:, 1], c[:, 0]) % (2.0 * math.pi)) / self.sin_a
+        across = np.cos(ang)[:, None] * self.ex + np.sin(ang)[:, None] * self.ey
+        return self.apex + rho[:, None] * (self.cos_a * self.axis + self.sin_a * across)
+
+    def scale(self, c: np.ndarray) -> np.ndarray:
+        return np.ones(c.shape[0])
+
+    def triangles(self, tri3: np.ndarray) -> np.ndarray:
+        """A face's triangles ``(t, 3, 3)`` in the chart; one across the cut
+        (corners more than half a turn apart) twice, once lifted past the
+        sector's far ray and once below its first."""
+        rho, ang = self._polar(tri3.reshape(-1, 3))
+        rho, ang = rho.reshape(-1, 3), ang.reshape(-1, 3)
+        across = ang.max(axis=1) - ang.min(axis=1) > math.pi
+        up = np.where(ang[across] < math.pi, ang[across] + 2.0 * math.pi, ang[across])
+        down = np.where(ang[across] >= math.pi, ang[across] - 2.0 * math.pi, ang[across])
+        parts = [(rho[~across], ang[~across]), (rho[across], up), (rho[across], down)]
+        return np.concatenate(
+            [
+                _rotated(r.reshape(-1), self.sin_a * a.reshape(-1)).reshape(-1, 3, 2)
+                for r, a in parts
+            ]
+        )
+
+    def images(self, c: np.ndarray, reach: float) -> list[np.ndarray]:
+        """The chart points ``c`` within ``reach`` of a side of the cut,
+        turned across it (by the sector's angle)."""
+        phi = libm.arctan2(c[:, 1], c[:, 0]) % (2.0 * math.pi)
+        rho = np.hypot(c[:, 0], c[:, 1])
+        low = _from_ray(rho, phi) < reach
+        high = _from_ray(rho, self.sector - phi) < reach
+        return [
+            _rotated(rho[low], phi[low] + self.sector),
+            _rotated(rho[high], phi[high] - self.sector),
+        ]
+
+    def from_cut(self, c: np.ndarray) -> np.ndarray:
+        """Distance in the chart from each point to the cut (either ray)."""
+        phi = libm.arctan2(c[:, 1], c[:, 0]) % (2.0 * math.pi)
+        rho = np.hypot(c[:, 0], c[:, 1])
+        return np.minimum(_from_ray(rho, phi), _from_ray(rho, self.sector - phi))
+
+    def from_half_turn(self, c: np.ndarray) -> np.ndarray:
+        """Distance in the chart from each point to the ray half a turn from the cut."""
+        phi = libm.arctan2(c[:, 1], c[:, 0]) % (2.0 * math.pi)
+        return _from_ray(np.hypot(c[:, 0], c[:, 1]), np.abs(phi - 0.5 * self.sector))
+
+
+def _rotated(rho: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """Polar coordinates to the plane's."""
+    return np.stack([rho * np.cos(phi), rho * np.sin(phi)], axis=1)
+
+
+def _from_ray(rho: np.ndarray, psi: np.ndarray) -> np.ndarray:
+    """Distance from a point at ``rho`` and angle ``psi`` off a ray from the
+    origin to that ray (to the origin past a right angle)."""
+    return np.where(np.abs(psi) < 0.5 * math.pi, rho * np.abs(np.sin(psi)), rho)
+
 
 class _Sphere(Stereographic):
     """The stereographic map with its scale (chart length per length); the
@@ -126,6 +229,10 @@ class _Sphere(Stereographic):
 
     def scale(self, c: np.ndarray) -> np.ndarray:
         return 1.0 + (c**2).sum(axis=1) / (2.0 * self.radius) ** 2
+
+    def triangles(self, tri3: np.ndarray) -> np.ndarray:
+        """A face's triangles ``(t, 3, 3)`` on the map."""
+        return self(tri3.reshape(-1, 3)).reshape(-1, 3, 2)
 
 
 def _face_triangles(face, tol: float) -> np.ndarray:
@@ -210,8 +317,9 @@ def _view(chart, tri3: np.ndarray, lines, h: float, inside=None, step=None) -> _
     """``chart``'s view of a face: its domain the face's tessellation
     ``tri3`` filled in (unless ``inside`` is given), its rims ``lines``."""
     if inside is None:
-        tri = chart(tri3.reshape(-1, 3)).reshape(-1, 3, 2)
-        inside = TriangleRaster(tri, h / RASTER, chart.period)
+        # a development's fan of slivers round the apex, grown by half a cell's diagonal
+        grow = h / RASTER / math.sqrt(2.0) if isinstance(chart, Developed) else 0.0
+        inside = TriangleRaster(chart.triangles(tri3), h / RASTER, chart.period, grow=grow)
     return _View(chart, inside, Rims(lines, chart, inside, h), h if step is None else step)
 
 
@@ -245,11 +353,17 @@ def _cylinder(face):
 
 
 def _on_surface(face, points: np.ndarray, tol: float) -> np.ndarray:
-    """Whether each point lies on the face's sphere or cylinder (to ``tol``)."""
+    """Whether each point lies on the face's sphere, cylinder or cone (to ``tol``)."""
     if face.geomType() == "SPHERE":
         sph = basis_surface(face).Sphere()
         d = np.linalg.norm(points - np.array(sph.Location().Coord()), axis=1)
         return np.abs(d - float(sph.Radius())) < tol
+    if face.geomType() == "CONE":
+        apex, axis, _, _, sin_a = _cone(face)
+        q = points - apex
+        along = dot(q, axis)
+        radial = np.linalg.norm(q - along[:, None] * axis, axis=1)
+        return (np.abs(radial * math.sqrt(1.0 - sin_a * sin_a) - along * sin_a) < tol) & (along > 0)
     o, _, _, ez, radius = _cylinder(face)
     q = points - o
     radial = np.linalg.norm(q - dot(q, ez)[:, None] * ez, axis=1)
@@ -281,10 +395,8 @@ def _repair_in(fi, face, view: _View, s: Samples, h, tol, movable, good, images)
     own = np.zeros(s.points.shape[0], dtype=bool)
     own[idx] = True
     frame = [rims.unfold(s.points[~own & ~s.on_feature], FRAME_REACH * h, 1e-6 * h)]
-    if images and chart.period is not None:
-        reach = IMAGE_REACH * h
-        low, high = c[:, 0] < reach, c[:, 0] > chart.period - reach
-        frame += [c[low] + [chart.period, 0.0], c[high] - [chart.period, 0.0]]
+    if images:
+        frame += chart.images(c, IMAGE_REACH * h)
     args = dict(
         inside=inside,
         clamp=rims.clamp(inside, CLEAR * h),
@@ -292,7 +404,11 @@ def _repair_in(fi, face, view: _View, s: Samples, h, tol, movable, good, images)
         judge_frame=True,
     )
     step = view.step
-    r = unstuck(c, free, step, repair(c, free, step, **args), good, **args)
+    # a development's corners where a notch's rims meet stay stuck whatever
+    # the shaken starts (a cone notched by a box: 19 bad triangles in 80 s
+    # of them, 17 kept); its repair ends at its corners' splits
+    shake = not isinstance(chart, Developed)
+    r = unstuck(c, free, step, repair(c, free, step, **args), good, shake=shake, **args)
     pts3 = chart.inverse(r.uv)
     kept = r.origin >= 0
     stay = kept & ~free[np.maximum(r.origin, 0)]
@@ -404,6 +520,34 @@ def _lay_cylinder(fi, face, view: _View, lines, s: Samples, h: float, tol: float
         np.vstack(lines),
         h,
     )
+
+
+def _lay_notched_cone(fi, face, view: _View, lines, s: Samples, h: float, tol: float):
+    """Replace a notched cone face's samples off its rims by the rings of
+    its whole cone (:func:`sr33.samplers.layers.lay_cone`, from its widest
+    rim to the apex) that lie in the face (``view``, a development) and
+    ``KEEP_OFF`` h off its rims.  Returns the layout's report, or None
+    where it lays nothing (its widest rim a smooth edge)."""
+    lay = lay_cone(fi, face, s, h, tol, whole=False)
+    if lay is None:
+        return None
+    chart = view.chart
+    on = np.flatnonzero(_on_surface(face, s.points, tol))
+    rows = np.where(lay.rows >= 0, lay.rows, lay.nrows)
+    # the apex, where the face keeps it, stays: the rings round it are laid for it
+    apex = np.linalg.norm(s.points[on] - chart.apex, axis=1) < tol
+    _relay(
+        s,
+        fi,
+        on,
+        view.inside(chart(s.points[on])) & ~apex,
+        lay.points,
+        view.inside(chart(lay.points)),
+        rows,
+        np.vstack(lines),
+        h,
+    )
+    return {**lay.report, "kind": "notched cone rings"}
 
 
 def _off_rims(s: Samples, idx: np.ndarray, rims: np.ndarray, h: float) -> np.ndarray:
@@ -548,19 +692,53 @@ def _layer(c: np.ndarray, d: np.ndarray, *, h: float) -> np.ndarray:
     return d < LAYER * h
 
 
-def _cut_pass(c: np.ndarray, d: np.ndarray, *, h: float, period: float, passes: int, k: int):
-    """Which samples of an unrolled cylinder move in pass ``k`` of ``passes``
-    (at ``c`` in the chart, ``d`` from the rims): those within ``LAYER`` h
-    of a rim; with two passes, not within ``CUT_CLEAR`` h of the pass's
-    cut, and in the second only those round the first pass's cut (half a
-    turn on)."""
+def _cut_pass(c: np.ndarray, d: np.ndarray, *, h: float, chart, passes: int, k: int, only=None):
+    """Which samples of a face unrolled or developed in ``chart`` move in
+    pass ``k`` of ``passes`` (at ``c`` in the chart, ``d`` from the rims):
+    those within ``LAYER`` h of a rim (of the rims in the k-d tree
+    ``only``, in space, when given: a notched cone's notch); with two
+    passes, not within ``CUT_CLEAR`` h of the pass's cut, and in the second
+    only those round the first pass's cut (half a turn on)."""
     layer = _layer(c, d, h=h)
+    if only is not None:
+        layer &= only.query(chart.inverse(c))[0] < LAYER * h
     if passes == 1:
         return layer
-    away = np.minimum(c[:, 0], period - c[:, 0]) > CUT_CLEAR * h
+    away = chart.from_cut(c) > CUT_CLEAR * h
     if k == 0:
         return layer & away
-    return layer & away & (np.abs(c[:, 0] - 0.5 * period) < (CUT_CLEAR + 1.0) * h)
+    return layer & away & (chart.from_half_turn(c) < (CUT_CLEAR + 1.0) * h)
+
+
+def _cone(face):
+    """A cone face's apex, unit axis (from the apex into the cone), the
+    directions across it (``ex`` its surface's, ``ey`` = axis × ex) and
+    the sine of its half-angle, as :func:`sr33.samplers.layers.lay_cone` takes them."""
+    cone = basis_surface(face).Cone()
+    pos = cone.Position()
+    apex = np.array(cone.Apex().Coord())
+    loc = np.array(pos.Location().Coord())
+    axis = (loc - apex) / np.linalg.norm(loc - apex)
+    ex = np.array(pos.XDirection().Coord())
+    return apex, axis, ex, np.cross(axis, ex), math.sin(abs(cone.SemiAngle()))
+
+
+def _notched_cone(face, lines, tol: float):
+    """The rims of a cone face that goes round, is no whole band and whose
+    widest rim is a whole circle (a cone notched by a boolean away from
+    its base): the other rims' points (the notch), or None."""
+    if whole_band(face) or not goes_round(face):
+        return None
+    apex, axis, _, _, _ = _cone(face)
+    reach = [float(dot(q - apex, axis).max()) for q in lines]
+    widest = int(np.argmax(reach))
+    edge = rim_edges(face)[widest]
+    if edge.geomType() != "CIRCLE" or not edge.IsClosed():
+        return None
+    rest = [q for i, q in enumerate(lines) if i != widest]
+    if not rest or max(float(dot(q - apex, axis).max()) for q in rest) > reach[widest] - tol:
+        return None
+    return np.vstack(rest)
 
 
 def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()) -> list[dict]:
@@ -597,13 +775,14 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
     tol = 1e-7 * size
     reports: list[dict] = []
     faces = occ.Faces()
-    spheres, cylinders = [], []
+    spheres, cylinders, cones = [], [], []
+    notches: dict[int, cKDTree] = {}  # a notched cone's notch: its rims' points
     feature = s.points[s.on_feature]
     if feature.shape[0] == 0:
         return reports
     for fi, face in enumerate(faces):
         kind = face.geomType()
-        if fi in skip or kind not in ("SPHERE", "CYLINDER"):
+        if fi in skip or kind not in ("SPHERE", "CYLINDER", "CONE"):
             continue
         rims = rim_edges(face)
         if not rims:
@@ -611,10 +790,16 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
         mids = np.array([e.positionAt(0.5).toTuple() for e in rims])
         if cKDTree(feature).query(mids)[0].max() > RIM_SAMPLED * h:
             continue  # a smooth edge: the face blends into its neighbour
+        lines = rim_lines(rims, h)
         if kind == "SPHERE":
-            spheres.append((fi, face, rim_lines(rims, h)))
+            spheres.append((fi, face, lines))
+        elif kind == "CONE":
+            notch = _notched_cone(face, lines, tol)
+            if notch is not None:
+                cones.append((fi, face, lines))
+                notches[fi] = cKDTree(notch)
         else:  # a whole band only where no layout took it (it is in skip otherwise)
-            cylinders.append((fi, face, rim_lines(rims, h)))
+            cylinders.append((fi, face, lines))
     views: dict[int, list[_View]] = {}  # per face, its chart (a cylinder's: per cut)
     wide = []
     for fi, face, lines in spheres:
@@ -632,6 +817,17 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
             _view(Unrolled(o, ex, ey, ez, radius, cut), tri3, lines, h) for cut in _cuts(face)
         ]
         _lay_cylinder(fi, face, views[fi][0], lines, s, h, tol)
+    for fi, face, lines in cones:
+        apex, axis, ex, ey, sin_a = _cone(face)
+        tri3 = _face_triangles(face, h / 20)
+        views[fi] = [
+            _view(Developed(apex, axis, ex, ey, sin_a, cut), tri3, lines, h)
+            for cut in (0.0, math.pi)
+        ]
+        rep = _lay_notched_cone(fi, face, views[fi][0], lines, s, h, tol)
+        if rep is not None:
+            reports.append(rep)
+        cylinders.append((fi, face, lines))  # repaired in its two developments as a cylinder
     for fi, face, chart, tri3, lines in wide:
         reports += _bitten_ball(fi, face, chart, tri3, lines, s, h, tol, size) or []
     layer = functools.partial(_layer, h=h)
@@ -645,7 +841,7 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
             passes = len(views[fi])
             for k, view in enumerate(views[fi]):
                 move = functools.partial(
-                    _cut_pass, h=h, period=view.chart.period, passes=passes, k=k
+                    _cut_pass, h=h, chart=view.chart, passes=passes, k=k, only=notches.get(fi)
                 )
                 rep = _repair_in(fi, face, view, s, h, tol, move, STUCK, passes > 1)
                 if rep is not None:
