@@ -274,11 +274,12 @@ def linked_across(adjacency, fi: int, edge, h: float | None = None):
     (:func:`whole_band`) whose smaller radius is at least ``LINK_RATIO`` of
     its larger one, or (given the spacing ``h``) whose circles lie less
     than ``LINK_WIDTH`` h apart: a chamfer's cone between a cylinder's rim
-    and the disk it bevels.  Samples at the same angles on both circles make the band's
-    cells rectangles however narrow the band is; two column counts make a
-    band narrower than a row a strip of needle triangles (a cylinder of
-    radius 0.33 chamfered by 0.05, its cone band's inner rim laid by the
-    disk and its outer one by the wall: III-ii ratios 0.93 to 1.0).
+    and the disk it bevels.  Samples at the same angles on both circles
+    make the band's cells rectangles however narrow the band is; two
+    column counts make a band narrower than a row a strip of needle
+    triangles (a cylinder of radius 0.33 chamfered by 0.05, its cone
+    band's inner rim laid by the disk and its outer one by the wall:
+    III-ii ratios 0.93 to 1.0).
     """
     other = adjacency.other(edge, fi)
     if other < 0 or edge.geomType() != "CIRCLE":
@@ -318,6 +319,23 @@ def linked_radius(adjacency, fi: int, edge, h: float | None = None) -> float:
     cylinder's two disks, of radii r and r - c, both take the count of r,
     the wall's)."""
     return max(linked_radii(adjacency, fi, edge, h))
+
+
+def cone_frame(face, tol: float = 0.0):
+    """A cone face's apex, unit axis (from the apex into the cone), the
+    directions across it (``ex`` its surface's, ``ey`` = axis × ex) and its
+    half-angle; None where its surface's reference circle lies within
+    ``tol`` of its apex."""
+    cone = basis_surface(face).Cone()
+    pos = cone.Position()
+    apex = np.array(cone.Apex().Coord())
+    loc = np.array(pos.Location().Coord())
+    length = float(norm(loc - apex))
+    if length <= 0.0 or length < tol:
+        return None
+    axis = (loc - apex) / length
+    ex = np.array(pos.XDirection().Coord())
+    return apex, axis, ex, np.cross(axis, ex), abs(cone.SemiAngle())
 
 
 def revolution_axis(face):

@@ -61,6 +61,7 @@ from .faces import (
     basis_surface,
     boundary_segments,
     cap_rim,
+    cone_frame,
     goes_round,
     linked_across,
     perpendicular,
@@ -1493,21 +1494,14 @@ def lay_cone(fi: int, face, s: Samples, h: float, tol: float, whole: bool = True
     lays a face that is no whole band (notched by a boolean) as its whole
     cone, from its widest rim to the apex: the caller keeps the points
     inside the face (:func:`sr33.samplers.outlines.repair_curved_faces`)."""
-    cone = basis_surface(face).Cone()
-    pos = cone.Position()
-    apex = np.array(cone.Apex().Coord())
-    loc = np.array(pos.Location().Coord())
-    if norm(loc - apex) < tol:
+    frame = cone_frame(face, tol)
+    if frame is None:
         return None
+    apex, axis, ex, ey, half = frame
     corners = np.array([v.toTuple() for v in face.Vertices()], dtype=np.float64)
     # no vertex at its apex (a notched cone is laid whole, to the apex)
     frustum = whole and not (norm(corners.reshape(-1, 3) - apex) < tol).any()
-    axis = (loc - apex) / norm(loc - apex)
-    ex = np.array(pos.XDirection().Coord())
-    ey = np.cross(axis, ex)
-    tan_a = math.tan(abs(cone.SemiAngle()))
-    sin_a = math.sin(abs(cone.SemiAngle()))
-    cos_a = math.cos(abs(cone.SemiAngle()))
+    tan_a, sin_a, cos_a = math.tan(half), math.sin(half), math.cos(half)
     q = s.points - apex
 
     along = dot(q, axis)
@@ -1542,16 +1536,15 @@ def lay_cone(fi: int, face, s: Samples, h: float, tol: float, whole: bool = True
         inner = (bottom / cos_a, _angles_about(q[low], ex, ey))
     rim_ang = _angles_about(q[rim], ex, ey)
     # the rings' step divides the slant to the apex into whole steps of
-    # about h; a frustum's band into steps of about its rim's gaps, so
-    # that a band a few rows wide gets near-square cells (a chamfer's
+    # about h; a frustum's band narrower than NARROW_BAND h into steps of
+    # about its rim's gaps, so that its cells are near squares (a chamfer's
     # band 1.6 h wide whose rims carry a hole's count, 1 h apart, kept
     # no ring at a step of h, its ring 0.58 h from the small circle
     # dropped: cells 1.6 h by 0.8 to 1 h, ratio 0.88; one 1.6 h wide
     # under a wall's count, 1.28 h apart, got a ring at a step of h:
     # cells 0.8 h by 1.28 h, ratio 0.86, and none by its gaps, 0.78)
-    if inner is None:
-        t = slant / steps(slant, h)
-    else:
+    t = slant / steps(slant, h)
+    if inner is not None and slant - inner[0] < NARROW_BAND * h:
         span = slant - inner[0]
         t = span / steps(span, 2.0 * math.pi * top * tan_a / rim_ang.size)
     # rings halving by design from the rim to the apex's last rows (one
@@ -1591,6 +1584,7 @@ def lay_cone(fi: int, face, s: Samples, h: float, tol: float, whole: bool = True
 
 
 APEX_KEEP = 5.0  # samples this near the apex (times t) stay
+NARROW_BAND = 3.0  # a frustum's band narrower than this (times h) steps by its rim's gaps
 # a cone's rings this near the apex (rows) end their columns by their gaps
 # and are repaired; farther out they halve by design.  Measured on the
 # default cone: 12 rows, worst 0.832 and a closed reconstruction; 10 and 11,

@@ -49,7 +49,15 @@ from sr33 import libm
 from sr33.mesh import dot
 
 from .chart import RimClamp, TriangleRaster
-from .faces import RIM_SAMPLED, Stereographic, basis_surface, goes_round, steps, whole_band
+from .faces import (
+    RIM_SAMPLED,
+    Stereographic,
+    basis_surface,
+    cone_frame,
+    goes_round,
+    steps,
+    whole_band,
+)
 from .layers import POLE_GOOD, RASTER, STUCK, lattice_revolved_body, lay_cone, unstuck
 from .repair import repair
 from .samples import Samples
@@ -138,7 +146,9 @@ class Developed:
     maps to ``ρ (cos φ, sin φ)``, ``φ = sin(a) ((θ - cut) mod 2π)``: an
     isometry onto a sector of angle ``2π sin(a)`` (``sector``) about the
     apex.  The cut's two sides are the sector's two rays; the chart has no
-    period (a turn is a rotation by ``sector``, not a translation)."""
+    period (a turn is a rotation by ``sector``, not a translation).  Points
+    outside the sector (the images across the cut) are frame points only:
+    ``inverse`` takes their angle modulo a full turn, not the sector."""
 
     period = None
 
@@ -711,16 +721,10 @@ def _cut_pass(c: np.ndarray, d: np.ndarray, *, h: float, chart, passes: int, k: 
 
 
 def _cone(face):
-    """A cone face's apex, unit axis (from the apex into the cone), the
-    directions across it (``ex`` its surface's, ``ey`` = axis × ex) and
-    the sine of its half-angle, as :func:`sr33.samplers.layers.lay_cone` takes them."""
-    cone = basis_surface(face).Cone()
-    pos = cone.Position()
-    apex = np.array(cone.Apex().Coord())
-    loc = np.array(pos.Location().Coord())
-    axis = (loc - apex) / np.linalg.norm(loc - apex)
-    ex = np.array(pos.XDirection().Coord())
-    return apex, axis, ex, np.cross(axis, ex), math.sin(abs(cone.SemiAngle()))
+    """A cone face's apex, axis, ``ex``, ``ey`` and the sine of its
+    half-angle (:func:`sr33.samplers.faces.cone_frame`)."""
+    apex, axis, ex, ey, half = cone_frame(face)
+    return apex, axis, ex, ey, math.sin(half)
 
 
 def _notched_cone(face, lines, tol: float):
