@@ -167,8 +167,15 @@ def test_homeomorphism_of_default_samplings_under_rigid_motions(name, motion, pe
     )
 
 
+#: not strict: on the same sampling's bytes and the same pinned packages it
+#: failed in stop 65's ``make check`` and passes on stop 66's machine (an AMD
+#: EPYC), so that the outcome hangs on the machine (the selection's path at
+#: the wedge's thin end), which is the defect this marks
+_WEDGE_MACHINE = _WEDGE_TURNED + "; its outcome differs between machines (stops 65 and 66)"
+
+
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason=_WEDGE_TURNED)
+@pytest.mark.xfail(strict=False, reason=_WEDGE_MACHINE)
 def test_regression_the_default_wedge_turned_reconstructs_within_h():
     """The rigid-motion property's example: the default wedge sampling (its
     samples shuffled, seed 0), turned by ``_WEDGE_TURN``, reconstructs
