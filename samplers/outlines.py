@@ -121,6 +121,10 @@ class Unrolled:
     def scale(self, c: np.ndarray) -> np.ndarray:
         return np.ones(c.shape[0])
 
+    #: a raster cell is inside only where its centre lies in a triangle; the
+    #: repair tries shaken starts when stuck
+    grow_raster, shaken = False, True
+
     def triangles(self, tri3: np.ndarray) -> np.ndarray:
         """A face's triangles ``(t, 3, 3)`` in the chart (across the cut as
         :class:`sr33.samplers.chart.TriangleRaster` takes them, by its period)."""
@@ -151,6 +155,11 @@ class Developed:
     ``inverse`` takes their angle modulo a full turn, not the sector."""
 
     period = None
+    #: the fan of slivers round the apex is thinner than a raster cell: cells
+    #: within half a diagonal of a triangle are inside; a notch's corners stay
+    #: stuck whatever the shaken starts (a cone notched by a box: 19 bad
+    #: triangles in 80 s of them, 17 kept), so its repair ends at the splits
+    grow_raster, shaken = True, False
 
     def __init__(self, apex, axis, ex, ey, sin_a: float, cut: float):
         self.apex, self.axis, self.ex, self.ey = apex, axis, ex, ey
@@ -167,8 +176,8 @@ class Developed:
         return _rotated(rho, self.sin_a * ang)
 
     def inverse(self, c: np.ndarray) -> np.ndarray:
-        rho = np.hypot(c[:, 0], c[:, 1])
-        ang = self.cut + (libm.arctan2(c[:, 1], c[:, 0]) % (2.0 * math.pi)) / self.sin_a
+        rho, phi = _polar_of(c)
+        ang = self.cut + phi / self.sin_a
         across = np.cos(ang)[:, None] * self.ex + np.sin(ang)[:, None] * self.ey
         return self.apex + rho[:, None] * (self.cos_a * self.axis + self.sin_a * across)
 
@@ -195,8 +204,7 @@ class Developed:
     def images(self, c: np.ndarray, reach: float) -> list[np.ndarray]:
         """The chart points ``c`` within ``reach`` of a side of the cut,
         turned across it (by the sector's angle)."""
-        phi = libm.arctan2(c[:, 1], c[:, 0]) % (2.0 * math.pi)
-        rho = np.hypot(c[:, 0], c[:, 1])
+        rho, phi = _polar_of(c)
         low = _from_ray(rho, phi) < reach
         high = _from_ray(rho, self.sector - phi) < reach
         return [
@@ -206,14 +214,18 @@ class Developed:
 
     def from_cut(self, c: np.ndarray) -> np.ndarray:
         """Distance in the chart from each point to the cut (either ray)."""
-        phi = libm.arctan2(c[:, 1], c[:, 0]) % (2.0 * math.pi)
-        rho = np.hypot(c[:, 0], c[:, 1])
+        rho, phi = _polar_of(c)
         return np.minimum(_from_ray(rho, phi), _from_ray(rho, self.sector - phi))
 
     def from_half_turn(self, c: np.ndarray) -> np.ndarray:
         """Distance in the chart from each point to the ray half a turn from the cut."""
-        phi = libm.arctan2(c[:, 1], c[:, 0]) % (2.0 * math.pi)
-        return _from_ray(np.hypot(c[:, 0], c[:, 1]), np.abs(phi - 0.5 * self.sector))
+        rho, phi = _polar_of(c)
+        return _from_ray(rho, np.abs(phi - 0.5 * self.sector))
+
+
+def _polar_of(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The plane's points in polar coordinates (radius, angle in [0, 2π))."""
+    return np.hypot(c[:, 0], c[:, 1]), libm.arctan2(c[:, 1], c[:, 0]) % (2.0 * math.pi)
 
 
 def _rotated(rho: np.ndarray, phi: np.ndarray) -> np.ndarray:
@@ -232,6 +244,7 @@ class _Sphere(Stereographic):
     centre of projection maps to no point (NaN or inf), without a warning."""
 
     period = None
+    grow_raster, shaken = False, True
 
     def __call__(self, p) -> np.ndarray:
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -327,8 +340,7 @@ def _view(chart, tri3: np.ndarray, lines, h: float, inside=None, step=None) -> _
     """``chart``'s view of a face: its domain the face's tessellation
     ``tri3`` filled in (unless ``inside`` is given), its rims ``lines``."""
     if inside is None:
-        # a development's fan of slivers round the apex, grown by half a cell's diagonal
-        grow = h / RASTER / math.sqrt(2.0) if isinstance(chart, Developed) else 0.0
+        grow = h / RASTER / math.sqrt(2.0) if chart.grow_raster else 0.0
         inside = TriangleRaster(chart.triangles(tri3), h / RASTER, chart.period, grow=grow)
     return _View(chart, inside, Rims(lines, chart, inside, h), h if step is None else step)
 
@@ -414,11 +426,7 @@ def _repair_in(fi, face, view: _View, s: Samples, h, tol, movable, good, images)
         judge_frame=True,
     )
     step = view.step
-    # a development's corners where a notch's rims meet stay stuck whatever
-    # the shaken starts (a cone notched by a box: 19 bad triangles in 80 s
-    # of them, 17 kept); its repair ends at its corners' splits
-    shake = not isinstance(chart, Developed)
-    r = unstuck(c, free, step, repair(c, free, step, **args), good, shake=shake, **args)
+    r = unstuck(c, free, step, repair(c, free, step, **args), good, shake=chart.shaken, **args)
     pts3 = chart.inverse(r.uv)
     kept = r.origin >= 0
     stay = kept & ~free[np.maximum(r.origin, 0)]
@@ -727,16 +735,17 @@ def _cone(face):
     return apex, axis, ex, ey, math.sin(half)
 
 
-def _notched_cone(face, lines, tol: float):
-    """The rims of a cone face that goes round, is no whole band and whose
-    widest rim is a whole circle (a cone notched by a boolean away from
-    its base): the other rims' points (the notch), or None."""
+def _notched_cone(face, rims, lines, tol: float):
+    """The rims (edges ``rims``, as points ``lines``) of a cone face that
+    goes round, is no whole band and whose widest rim is a whole circle (a
+    cone notched by a boolean away from its base): the other rims' points
+    (the notch), or None."""
     if whole_band(face) or not goes_round(face):
         return None
     apex, axis, _, _, _ = _cone(face)
     reach = [float(dot(q - apex, axis).max()) for q in lines]
     widest = int(np.argmax(reach))
-    edge = rim_edges(face)[widest]
+    edge = rims[widest]
     if edge.geomType() != "CIRCLE" or not edge.IsClosed():
         return None
     rest = [q for i, q in enumerate(lines) if i != widest]
@@ -798,7 +807,7 @@ def repair_curved_faces(occ, s: Samples, h: float, size: float, skip=frozenset()
         if kind == "SPHERE":
             spheres.append((fi, face, lines))
         elif kind == "CONE":
-            notch = _notched_cone(face, lines, tol)
+            notch = _notched_cone(face, rims, lines, tol)
             if notch is not None:
                 cones.append((fi, face, lines))
                 notches[fi] = cKDTree(notch)
