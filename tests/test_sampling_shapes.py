@@ -1572,6 +1572,7 @@ def _notched_cylinder():
     return shapes.from_cad(solid, name="notched cylinder")
 
 
+@pytest.mark.slow  # 27-31 s: make check (the suite's 10 minutes)
 def test_a_cylinder_notched_by_a_ball_is_repaired_in_its_charts():
     """Faces no layout takes are repaired in charts of their own, whatever
     their rims (:mod:`sr33.samplers.outlines`): the ball's dish on its
@@ -1595,6 +1596,7 @@ def test_a_cylinder_notched_by_a_ball_is_repaired_in_its_charts():
     assert np.nanmax(ratio) < 0.85
 
 
+@pytest.mark.slow  # 27-31 s: make check (the suite's 10 minutes)
 def test_a_whole_wall_between_two_rims_that_disagree_is_repaired_in_its_chart():
     """A cylinder countersunk and drilled through: its top and bottom are
     annuli laid in rings (inner rims 0.25 and 0.125), whose outer rims,
@@ -1633,6 +1635,7 @@ def test_regression_a_countersunk_cylinder_at_2000_samples_conforms():
     assert np.nanmax(_geodesic_ratios(s, 2000)[1]) < 0.85
 
 
+@pytest.mark.slow  # 27-31 s: make check (the suite's 10 minutes)
 def test_a_frustums_rings_take_the_phase_of_its_small_rim():
     """A cone frustum (0.5 -> 0.25, 0.5 high) drilled through (0.1): its
     small rim is the top annulus's, laid in rings round the hole with 62

@@ -167,6 +167,80 @@ def test_a_narrow_chamfer_round_a_polygon_prism_breaks_iii_only_at_its_corners()
     assert far.size == 0 or far.max() < 2.0
 
 
+def test_a_chamfer_two_h_wide_slanted_to_the_rows_is_scanned_along_its_edges():
+    """A prism over a quadrilateral whose sides run along no axis, its top
+    edges chamfered 0.042: strips 1.6 h wide at 2,500 samples, wider than
+    two clearances (a row fits between their edges) and slanted to every
+    scan direction.  Cut across by their family's planes, they kept a few
+    samples inside, their two edges on two lattices, and 31 samples broke
+    III-ii (0.996; 88 at 3,000 samples).  Each strip is now scanned along
+    its edges (``_strip_rows``): its direction lies in its plane square to
+    its edges, its two edges carry one set of columns (the longer follows
+    the cap's edge, ``_side_followers``), its rows are spaced by the width
+    over the whole number of steps nearest its columns' step
+    (``_strip_planes``: here one, the cap's rows crossing its edge 1.2 to
+    1.4 h apart), and what breaks III-ii is where the mitres meet the
+    sides, within 2.5 h of a corner (13 samples, 0.98)."""
+    import cadquery as cq
+
+    from sr33.samplers.faces import steps
+    from sr33.samplers.scanline import _strip_rows
+    from sr33.validators.conditions import sample_conditions
+
+    ring = [(0.569, -0.288), (-0.02, 0.6375), (-0.638, 0.0), (0.0036, -0.638)]
+    prism = cq.Workplane().polyline(ring).close().extrude(0.568).translate((0, 0, -0.284))
+    s = shapes.from_cad(prism.edges(">Z").chamfer(0.042).val())
+    r = scan(s, target_points=2500, quiet=True)
+    h = r.meta["spacing"]
+    faces = s.solid.Faces()
+    dirs = np.asarray(r.meta["directions"])
+    width = 0.042 * np.sqrt(2.0)
+    strips = 0
+    for fi, f in enumerate(faces):
+        n = np.array(f.normalAt().toTuple())
+        if abs(n[2]) < 1e-6 or abs(abs(n[2]) - 1.0) < 1e-6:
+            continue  # a side or a cap
+        strips += 1
+        d = dirs[r.meta["face_directions"][fi]]
+        e1, e2 = sorted(f.Edges(), key=lambda e: -e.Length())[:2]
+        a1, a2 = (np.array(e.startPoint().toTuple()) for e in (e1, e2))
+        u = np.array(e1.endPoint().toTuple()) - a1
+        u /= np.linalg.norm(u)
+        assert abs(d @ u) < 1e-9 and abs(d @ n) < 1e-9
+        assert np.abs(d).max() < 1.0 - 1e-9  # along no axis
+        # the two edges' samples stand across each other, their ends aside
+        on = []
+        for a, e in ((a1, e1), (a2, e2)):
+            q = r.points - a
+            t = q @ u
+            off = np.linalg.norm(q - t[:, None] * u, axis=1)
+            ends = sorted((np.array(p.toTuple()) - a1) @ u for p in (e.startPoint(), e.endPoint()))
+            t = (r.points - a1) @ u  # along the longer edge, from its start
+            on.append(np.sort(t[(off < 1e-9) & (t > ends[0] - 1e-9) & (t < ends[1] + 1e-9)]))
+        lead, other = on
+        inner = other[(other > other[0] + 1.5 * h) & (other < other[-1] - 1.5 * h)]
+        assert inner.size >= 10
+        assert np.abs(inner[:, None] - lead[None]).min(axis=1).max() < 1e-6 * h
+        step = float(np.median(np.diff(inner)))
+        assert 0.9 * h < step < 1.45 * h
+        # its rows: the width over the steps nearest the columns' step
+        rows = steps(width, step)
+        q = r.points[(r.face_id == fi) & ~r.on_feature] - a1
+        off = np.linalg.norm(q - (q @ u)[:, None] * u, axis=1)
+        on_row = np.abs(off / (width / rows) - np.round(off / (width / rows))) < 1e-6
+        assert rows == 1 and q.shape[0] <= 8 or on_row.mean() >= 0.6
+    assert strips == 4
+    # a strip wider than three spacings, or narrower than two clearances, keeps its family
+    for h_try in (width / 3.2, width / 1.3):
+        same, fam, held = _strip_rows(faces, np.eye(3), [0] * len(faces), h_try, 1e-9)
+        assert same.shape == (3, 3) and fam == [0] * len(faces) and not held
+    w = sample_conditions(r.points, s.truth_vertices, s.truth_triangles).worst_ratio
+    bad = r.points[w >= np.sqrt(3) / 2]
+    corners = np.array([v.toTuple() for v in s.solid.Vertices()])
+    far = np.linalg.norm(bad[:, None] - corners[None], axis=2).min(axis=1) / h
+    assert bad.shape[0] <= 20 and (far.size == 0 or far.max() < 2.5)
+
+
 def test_a_box_fused_on_a_corner_meets_condition_iii_with_the_margin():
     """A box 0.4 with a box 0.24 fused on its top corner (the survey's
     boolean seam class, axis-aligned): 237 samples at or above 0.85 before
