@@ -1146,7 +1146,11 @@ def _side_followers(
     An edge that follows holds its lead's lattice, so it may lead in turn
     (a chain): a chamfer scanned along its edges (:func:`_strip_rows`)
     has its edge on the side follow its edge on the cap, whose rows cross
-    it, and the side's base follows that.  Of two edges of such a strip
+    it, and the side's base follows that (of two edges that both hold a
+    lattice, one by following and one by crossings, the first leads: the
+    cap across the base then meets samples off its rows' ends, which its
+    boundary layer's repair takes, rather than the side's columns breaking
+    off in its middle).  Of two edges of such a strip
     (narrower than ``NARROW_STRIP`` steps) that hold nothing, the shorter
     follows the longer (the first on a tie).  The faces are visited in
     order until no edge is added; an edge follows one edge at most, and
