@@ -180,7 +180,8 @@ def test_a_chamfer_two_h_wide_slanted_to_the_rows_is_scanned_along_its_edges():
     over the whole number of steps nearest its columns' step
     (``_strip_planes``: here one, the cap's rows crossing its edge 1.2 to
     1.4 h apart), and what breaks III-ii is where the mitres meet the
-    sides, within 2.5 h of a corner (13 samples, 0.98)."""
+    sides, within 3 h of a corner (13 samples, 0.98, the farthest 2.3 h
+    off; before: 14 on the top cap far from any)."""
     import cadquery as cq
 
     from sr33.samplers.faces import steps
@@ -238,7 +239,7 @@ def test_a_chamfer_two_h_wide_slanted_to_the_rows_is_scanned_along_its_edges():
     bad = r.points[w >= np.sqrt(3) / 2]
     corners = np.array([v.toTuple() for v in s.solid.Vertices()])
     far = np.linalg.norm(bad[:, None] - corners[None], axis=2).min(axis=1) / h
-    assert bad.shape[0] <= 20 and (far.size == 0 or far.max() < 2.5)
+    assert bad.shape[0] <= 20 and (far.size == 0 or far.max() < 3.0)
 
 
 def test_a_box_fused_on_a_corner_meets_condition_iii_with_the_margin():
