@@ -22,10 +22,12 @@ FEATURE_CLEARANCE = 0.75  # no scan-line sample nearer to a sampled edge, times 
 #: edges holds no scan row: a strip, whose two long edges carry one set of
 #: samples across it (the scan rows' strip followers; the repair keeps them)
 STRIP_WIDTH = 2.0 * FEATURE_CLEARANCE
-#: a planar face between two parallel straight edges narrower than this
-#: (times h), but not a strip, is scanned along its edges: one or two rows
-#: between them (:func:`sr33.samplers.scanline.scan`'s strip rows)
-NARROW_STRIP = 3.0
+#: a band narrower than this (times h) is laid by the steps of its edges:
+#: a planar face between two parallel straight edges, not a strip, is
+#: scanned along them, at most two rows between them
+#: (:func:`sr33.samplers.scanline.scan`'s strip rows); a frustum's band
+#: steps by its rim's gaps (:func:`sr33.samplers.layers.lay_cone`)
+NARROW_BAND = 3.0
 
 
 def axis_index(u: np.ndarray) -> int | None:

@@ -55,6 +55,7 @@ from .chart import (
 )
 from .disks import HALVE_GAP
 from .faces import (
+    NARROW_BAND,
     STRIP_WIDTH,
     Stereographic,
     axis_index,
@@ -1584,7 +1585,6 @@ def lay_cone(fi: int, face, s: Samples, h: float, tol: float, whole: bool = True
 
 
 APEX_KEEP = 5.0  # samples this near the apex (times t) stay
-NARROW_BAND = 3.0  # a frustum's band narrower than this (times h) steps by its rim's gaps
 # a cone's rings this near the apex (rows) end their columns by their gaps
 # and are repaired; farther out they halve by design.  Measured on the
 # default cone: 12 rows, worst 0.832 and a closed reconstruction; 10 and 11,

@@ -79,7 +79,7 @@ from .adjacency import EdgeFaces
 from .bands import developable_bands
 from .faces import (
     FEATURE_CLEARANCE,
-    NARROW_STRIP,
+    NARROW_BAND,
     STRIP_WIDTH,
     axis_index,
     basis_surface,
@@ -385,11 +385,11 @@ def _face_columns(face, anchor, axis_steps, ratio: float, h: float, tol: float):
     return own_anchor, own_steps
 
 
-def _strip_rows(faces, dirs: np.ndarray, fam: list[int], h: float, tol: float):
+def _strip_rows(ef: EdgeFaces, lines, by_face, dirs: np.ndarray, fam: list[int], h: float):
     """Scan directions with a narrow planar strip's rows along its edges.
 
     A planar face between two parallel straight edges, its corners all
-    within ``NARROW_STRIP`` h of each one's line but not within
+    within ``NARROW_BAND`` h of each one's line but not within
     ``STRIP_WIDTH`` h (a strip, whose rows would all fall within the
     clearance of its edges), holds at most two rows between its edges.  The
     planes of its family cut it across them when its edges run along no
@@ -404,34 +404,34 @@ def _strip_rows(faces, dirs: np.ndarray, fam: list[int], h: float, tol: float):
     direction keeps it (a chamfer on an axis-aligned box: its rows across
     it put one sample on each of the edges' columns).
 
-    Returns the directions (``dirs`` with new ones appended, one shared by
-    strips parallel to each other), each face's direction index, and per
-    strip its two edges (face index -> (longer, other)).
+    ``lines`` and ``by_face`` are the shape's straight edges
+    (:func:`_straight_edges`); a face's are tried longest first (the first
+    in the shape's edge order on a tie).  Returns the directions (``dirs``
+    with new ones appended, one shared by strips parallel to each other),
+    each face's direction index, and per strip its two edges (face index ->
+    (longer, other), edge indices).
     """
     out, fam = [np.asarray(d, dtype=float) for d in dirs], list(fam)
     strips = {}
-    for fi, face in enumerate(faces):
+    for fi, face in enumerate(ef.faces):
         if face.geomType() != "PLANE":
             continue
-        lines = [e for e in face.Edges() if e.geomType() == "LINE" and e.Length() > tol]
-        lines.sort(key=lambda e: -e.Length())
+        mine = sorted(by_face.get(fi, ()), key=lambda ei: (-lines[ei][2], ei))
         pick = None
-        for i, e1 in enumerate(lines):
-            a1, u1 = _line(e1)
-            width = width_across(face, a1, u1)
-            if not STRIP_WIDTH * h <= width < NARROW_STRIP * h or e1.Length() < 2.0 * width:
+        for i, e1 in enumerate(mine):
+            width = width_across(face, *lines[e1][:2])
+            if not STRIP_WIDTH * h <= width < NARROW_BAND * h or lines[e1][2] < 2.0 * width:
                 continue
-            for e2 in lines[i + 1 :]:
-                a2, u2 = _line(e2)
-                gap = float(norm((a2 - a1) - dot(a2 - a1, u1) * u1))
-                if abs(abs(float(dot(u1, u2))) - 1.0) <= 1e-9 and abs(gap - width) <= 1e-6 * width:
+            for e2 in mine[i + 1 :]:
+                gap = _parallel_gap(lines, e1, e2)
+                if gap is not None and abs(gap - width) <= 1e-6 * width:
                     pick = (e1, e2)
                     break
             if pick is not None:
                 break
         if pick is None:
             continue
-        u = _line(pick[0])[1]
+        u = lines[pick[0]][1]
         along = abs(float(dot(out[fam[fi]], u)))
         if along <= 1e-9 or along >= 1.0 - 1e-9:
             continue  # rows along the strip's edges, or across them
@@ -449,14 +449,19 @@ def _strip_rows(faces, dirs: np.ndarray, fam: list[int], h: float, tol: float):
     return np.array(out), fam, strips
 
 
-def _line(edge) -> tuple[np.ndarray, np.ndarray]:
-    """A straight edge's start and unit direction."""
-    a = np.array(edge.startPoint().toTuple())
-    b = np.array(edge.endPoint().toTuple())
-    return a, (b - a) / norm(b - a)
+def _parallel_gap(lines, e1: int, e2: int) -> float | None:
+    """How far apart the lines of two straight edges run (``lines`` from
+    :func:`_straight_edges`); None where they are not parallel."""
+    a1, u1, _ = lines[e1]
+    a2, u2, _ = lines[e2]
+    if abs(abs(float(dot(u1, u2))) - 1.0) > 1e-9:
+        return None
+    return float(norm((a2 - a1) - dot(a2 - a1, u1) * u1))
 
 
-def _strip_planes(strips, ef: EdgeFaces, planes: list, h: float) -> dict[int, tuple[float, float]]:
+def _strip_planes(
+    strips, ef: EdgeFaces, lines, planes: list, h: float
+) -> dict[int, tuple[float, float]]:
     """The first plane and spacing of each narrow strip's rows
     (:func:`_strip_rows`): anchored on its two edges, the width divided into
     ``R`` steps near the step of its edges' samples (``R`` at least 1).
@@ -475,17 +480,19 @@ def _strip_planes(strips, ef: EdgeFaces, planes: list, h: float) -> dict[int, tu
     for fi, (e1, e2) in sorted(strips.items()):
         d = planes[fi][0]
         along = None
-        for e in (e1, e2):
-            a, u = _line(e)
-            k = ef.index(e)
-            adjacent = [j for j in ef.faces_of[k] if j != fi] if k >= 0 else []
-            cross = _row_crossings(a, u, e.Length(), adjacent, ef.faces, planes, EDGE_STEP * h)
+        for ei in (e1, e2):
+            adjacent = [j for j in ef.faces_of[ei] if j != fi]
+            a, u, _ = lines[ei]
+            cross = _row_crossings(
+                a, u, ef.edges[ei].Length(), adjacent, ef.faces, planes, EDGE_STEP * h
+            )
             if cross is not None:
                 along = cross[1]
                 break
         if along is None:
-            along = e1.Length() / steps(e1.Length(), EDGE_STEP * h)
-        off = sorted(float(dot(_line(e)[0], d)) for e in (e1, e2))
+            length = ef.edges[e1].Length()  # the edge's own length, as its equal steps take it
+            along = length / steps(length, EDGE_STEP * h)
+        off = sorted(float(dot(lines[ei][0], d)) for ei in (e1, e2))
         width = off[1] - off[0]
         out[fi] = (off[0], width / steps(width, along))
     return out
@@ -1118,9 +1125,9 @@ def _strip_followers(ef: EdgeFaces, width: float, tol: float, banded=()) -> dict
             if width_across(face, a1, u1) >= width:
                 continue
             for e2 in mine[i + 1 :]:
-                a2, u2, l2 = lines[e2]
-                gap = float(norm((a2 - a1) - dot(a2 - a1, u1) * u1))
-                if abs(abs(float(dot(u1, u2))) - 1.0) > 1e-9 or gap <= tol:
+                l2 = lines[e2][2]
+                gap = _parallel_gap(lines, e1, e2)
+                if gap is None or gap <= tol:
                     continue
                 lead, follow = (e1, e2) if l1 >= l2 - tol else (e2, e1)
                 if lead not in out and follow not in out:
@@ -1151,7 +1158,7 @@ def _side_followers(
     cap across the base then meets samples off its rows' ends, which its
     boundary layer's repair takes, rather than the side's columns breaking
     off in its middle).  Of two edges of such a strip
-    (narrower than ``NARROW_STRIP`` steps) that hold nothing, the shorter
+    (narrower than ``NARROW_BAND`` steps) that hold nothing, the shorter
     follows the longer (the first on a tie).  The faces are visited in
     order until no edge is added; an edge follows one edge at most, and
     never one that follows it; narrow faces are visited first, so that a
@@ -1161,6 +1168,7 @@ def _side_followers(
     busy = set(taken or {}) | set((taken or {}).values())
     lines, by_face = _straight_edges(ef, tol)
     held: dict[tuple[int, int], bool] = {}
+    leads: set[int] = set()
 
     def holds(ei: int, k: int) -> bool:
         if (ei, k) not in held:
@@ -1177,7 +1185,7 @@ def _side_followers(
 
     def narrow(k: int) -> bool:
         face = ef.faces[k]
-        return any(width_across(face, *lines[ei][:2]) < NARROW_STRIP * step for ei in by_face[k])
+        return any(width_across(face, *lines[ei][:2]) < NARROW_BAND * step for ei in by_face[k])
 
     # the strips first (their two edges join across them), then the rest
     order = sorted(by_face, key=lambda k: (not narrow(k), k))
@@ -1199,15 +1207,16 @@ def _side_followers(
                         lead, follow = (e1, e2) if f1 else (e2, e1)
                     elif f1 and (e1 in out) != (e2 in out):
                         lead, follow = (e1, e2) if e1 in out else (e2, e1)
-                    elif f1 or width_across(face, *lines[e1][:2]) >= NARROW_STRIP * step:
+                    elif f1 or width_across(face, *lines[e1][:2]) >= NARROW_BAND * step:
                         continue
                     else:  # a narrow strip's two free edges: the longer leads
                         lead, follow = (e1, e2) if lines[e1][2] >= lines[e2][2] - tol else (e2, e1)
                     if {lead, follow} & busy or follow in out or leads_to(lead, follow):
                         continue
-                    if any(v == follow for v in out.values()):
+                    if follow in leads:
                         continue  # it leads already: it keeps its own lattice
                     out[follow] = lead
+                    leads.add(lead)
                     added = True
     return out
 
@@ -1406,7 +1415,9 @@ def scan(
             )
         tol = 1e-7 * size
         fam = [_face_family(f, dirs, size / 200) for f in faces]
-        dirs, fam, strips = _strip_rows(faces, dirs, fam, h, tol)
+        edge_faces = EdgeFaces(occ)
+        lines, by_face = _straight_edges(edge_faces, tol)
+        dirs, fam, strips = _strip_rows(edge_faces, lines, by_face, dirs, fam, h)
         corner = _box_corners(lo, hi)
 
         # rows along a coordinate axis: r times that axis's plane spacing
@@ -1431,8 +1442,7 @@ def scan(
             t0, hf = aligned[fi]
             crosses.append(_cross_lattice(face, d, hf, ratio, columns[fi][0], tol))
             planes.append((d, t0, hf, _columns(face, d, hf, ratio, *columns[fi], crosses[fi])))
-        edge_faces = EdgeFaces(occ)
-        for fi, (t0, hf) in _strip_planes(strips, edge_faces, planes, h).items():
+        for fi, (t0, hf) in _strip_planes(strips, edge_faces, lines, planes, h).items():
             d = planes[fi][0]
             crosses[fi] = _cross_lattice(faces[fi], d, hf, ratio, columns[fi][0], tol)
             planes[fi] = (d, t0, hf, _columns(faces[fi], d, hf, ratio, *columns[fi], crosses[fi]))

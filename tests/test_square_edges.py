@@ -184,8 +184,9 @@ def test_a_chamfer_two_h_wide_slanted_to_the_rows_is_scanned_along_its_edges():
     off; before: 14 on the top cap far from any)."""
     import cadquery as cq
 
+    from sr33.samplers.adjacency import EdgeFaces
     from sr33.samplers.faces import steps
-    from sr33.samplers.scanline import _strip_rows
+    from sr33.samplers.scanline import _straight_edges, _strip_rows
     from sr33.validators.conditions import sample_conditions
 
     ring = [(0.569, -0.288), (-0.02, 0.6375), (-0.638, 0.0), (0.0036, -0.638)]
@@ -232,8 +233,10 @@ def test_a_chamfer_two_h_wide_slanted_to_the_rows_is_scanned_along_its_edges():
         assert rows == 1 and q.shape[0] <= 8 or on_row.mean() >= 0.6
     assert strips == 4
     # a strip wider than three spacings, or narrower than two clearances, keeps its family
+    ef = EdgeFaces(s.solid)
+    lines, by_face = _straight_edges(ef, 1e-9)
     for h_try in (width / 3.2, width / 1.3):
-        same, fam, held = _strip_rows(faces, np.eye(3), [0] * len(faces), h_try, 1e-9)
+        same, fam, held = _strip_rows(ef, lines, by_face, np.eye(3), [0] * len(faces), h_try)
         assert same.shape == (3, 3) and fam == [0] * len(faces) and not held
     w = sample_conditions(r.points, s.truth_vertices, s.truth_triangles).worst_ratio
     bad = r.points[w >= np.sqrt(3) / 2]
