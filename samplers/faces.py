@@ -148,11 +148,25 @@ def thin(
     return np.array(keep, dtype=np.int64)
 
 
+def face_mesh(shape, tol: float, angular: float) -> tuple[np.ndarray, np.ndarray]:
+    """A fresh OCC tessellation of ``shape`` (face or solid): vertices (n, 3), triangles (t, 3).
+
+    CadQuery's ``tessellate`` keeps any triangulation the shape already
+    carries that is at least as fine as asked, and stores the one it makes
+    on the shape; the mesh of a face would then depend on what was meshed
+    before, in this sampling or in an earlier one of the same solid (two
+    scans of one solid in one process gave different samples).  A copy
+    without triangulation is meshed instead, so the mesh depends on
+    ``shape``, ``tol`` and ``angular`` only and the input is not modified.
+    """
+    verts, tris = shape.copy(mesh=False).tessellate(tol, angular)
+    v = np.array([q.toTuple() for q in verts], dtype=np.float64).reshape(-1, 3)
+    return v, np.array(tris, dtype=np.int64).reshape(-1, 3)
+
+
 def boundary_segments(face, to2d, tol: float) -> np.ndarray:
     """Boundary edges of the face's own fine tessellation, in 2-D, as (s, 2, 2)."""
-    verts, tris = face.tessellate(tol, 0.05)
-    v = np.array([q.toTuple() for q in verts])
-    t = np.array(tris, dtype=np.int64).reshape(-1, 3)
+    v, t = face_mesh(face, tol, 0.05)
     uniq, counts = edge_uses(t)
     free = uniq[counts == 1]
     return to2d(v)[free]

@@ -54,6 +54,7 @@ from .faces import (
     Stereographic,
     basis_surface,
     cone_frame,
+    face_mesh,
     goes_round,
     steps,
     whole_band,
@@ -260,9 +261,7 @@ class _Sphere(Stereographic):
 
 def _face_triangles(face, tol: float) -> np.ndarray:
     """The face's own tessellation (tolerance ``tol``) as 3-D triangles ``(t, 3, 3)``."""
-    verts, tris = face.tessellate(tol, 0.1)
-    v = np.array([q.toTuple() for q in verts])
-    t = np.array(tris, dtype=np.int64).reshape(-1, 3)
+    v, t = face_mesh(face, tol, 0.1)
     return v[t]
 
 

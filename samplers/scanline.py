@@ -84,6 +84,7 @@ from .faces import (
     axis_index,
     basis_surface,
     exact_bounds,
+    face_mesh,
     goes_round,
     nearest_face,
     perpendicular,
@@ -500,11 +501,9 @@ def _strip_planes(
 
 def _face_family(face, dirs: np.ndarray, tol: float) -> int:
     """The direction that cuts the face most transversally (area-weighted |n·d|)."""
-    verts, tris = face.tessellate(tol, 0.3)
-    if not tris:
+    p, t = face_mesh(face, tol, 0.3)
+    if not t.shape[0]:
         return 0
-    p = np.array([v.toTuple() for v in verts])
-    t = np.array(tris)
     cr = np.cross(p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]])
     area = np.linalg.norm(cr, axis=1)
     keep = area > 0
@@ -531,11 +530,18 @@ def _edges_of(shape) -> list:
 
 
 def _section(face, origin, normal) -> list:
-    """Edges of the intersection of a face with a plane."""
+    """Edges of the intersection of a face with a plane.
+
+    The section is non-destructive: by default OCC's Boolean operations may
+    raise the tolerances of their arguments' edges and vertices in place,
+    and a later section of the same face (in this scan or another scan of
+    the same solid) then differs in its last bits.
+    """
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
     from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
 
     sec = BRepAlgoAPI_Section(face.wrapped, gp_Pln(gp_Pnt(*origin), gp_Dir(*normal)), False)
+    sec.SetNonDestructive(True)
     sec.Approximation(True)
     sec.Build()
     if not sec.IsDone():
@@ -1281,10 +1287,10 @@ def _fill_gaps(occ, faces, points: np.ndarray, h: float, size: float) -> np.ndar
     import cadquery as cq
     from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 
-    tv, tt = occ.tessellate(size / 500.0, 0.1)
-    if not tt:
+    tv, tt = face_mesh(occ, size / 500.0, 0.1)
+    if not tt.shape[0]:
         return np.empty((0, 3))
-    dense = surface_points(np.array([v.toTuple() for v in tv]), np.array(tt), 20000, seed=0)
+    dense = surface_points(tv, tt, 20000, seed=0)
     dist, _ = cKDTree(points).query(dense)
     radius = FILL_RADIUS * h
     if dist.max() <= radius:

@@ -31,6 +31,7 @@ from .faces import (
     Stereographic,
     basis_surface,
     boundary_segments,
+    face_mesh,
     goes_round,
     rims_sampled,
 )
@@ -187,8 +188,8 @@ def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=N
     if got is None:
         return None
     centre, radius, pole = got
-    verts, _ = face.tessellate(h / 20, 0.3)
-    reach = dot(np.array([v.toTuple() for v in verts]) - centre, pole)
+    verts, _ = face_mesh(face, h / 20, 0.3)
+    reach = dot(verts - centre, pole)
     if reach.min() <= FACING * radius:
         return None  # the face wraps too far round for one map
     to2d = Stereographic(centre, radius, pole)

@@ -87,6 +87,43 @@ def test_same_arguments_same_samples(cylinder):
     assert not np.array_equal(a.points, c.points)
 
 
+def _tolerances(solid) -> list[float]:
+    from OCP.BRep import BRep_Tool
+
+    return [BRep_Tool.Tolerance_s(v.wrapped) for v in solid.Vertices()] + [
+        BRep_Tool.Tolerance_s(e.wrapped) for e in solid.Edges()
+    ]
+
+
+def _meshed_faces(solid) -> int:
+    from OCP.BRep import BRep_Tool
+    from OCP.TopLoc import TopLoc_Location
+
+    return sum(
+        BRep_Tool.Triangulation_s(f.wrapped, TopLoc_Location()) is not None for f in solid.Faces()
+    )
+
+
+def test_a_solid_scanned_again_gives_the_same_bytes_and_is_left_as_it_was():
+    """Scanning must not change the solid: OCC's sections raised the
+    tolerances of the face's edges in place (a second scan of this chamfered
+    hexagon in the same process moved 49 samples by a last bit) and
+    CadQuery's tessellate stored meshes on the faces, reused by later ones."""
+    ring = [(0.661, 0.215), (0.217, 0.660), (-0.503, 0.479), (-0.679, 0.149),
+            (-0.348, -0.602), (0.266, -0.642)]  # fmt: skip
+    prism = cq.Workplane().polyline(ring).close().extrude(0.51).translate((0, 0, -0.255))
+    solid = prism.edges(">Z").chamfer(0.06).val()
+    before = _tolerances(solid)
+    first = scan(solid, target_points=2500, quiet=True, repair=False)
+    assert _tolerances(solid) == before
+    assert _meshed_faces(solid) == 0
+    again = scan(solid, target_points=2500, quiet=True, repair=False)
+    fresh = scan(solid.copy(), target_points=2500, quiet=True, repair=False)
+    for other in (again, fresh):
+        assert first.points.tobytes() == other.points.tobytes()
+        assert np.array_equal(first.face_id, other.face_id)
+
+
 def test_jitter_and_dropout(box):
     clean = scan(box, 0.1)
     noisy = scan(box, 0.1, jitter=0.05, seed=1)
