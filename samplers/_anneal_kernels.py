@@ -172,7 +172,7 @@ def anneal_corner(
     sigma,
     t0,
     grid,
-    lo,
+    glo,
     cell,
 ):
     """One seeded annealing of a corner's region (:func:`corner_score`; the
@@ -195,7 +195,7 @@ def anneal_corner(
     m = pts.shape[0]
     p = pts.copy()
     movable = np.flatnonzero(kind != FIXED)
-    score, cap = region_score(p, ray, dirs, judged, grid, lo, cell, h, gap_lo, gap_hi, short, wide)
+    score, cap = region_score(p, ray, dirs, judged, grid, glo, cell, h, gap_lo, gap_hi, short, wide)
     if movable.size == 0:
         return p, score
     cap += 1e-9
@@ -246,10 +246,10 @@ def anneal_corner(
             if dirs.shape[0] == 0:
                 c = clear * h
                 if not (
-                    _inside(grid, lo, cell, nx - c, ny)
-                    and _inside(grid, lo, cell, nx + c, ny)
-                    and _inside(grid, lo, cell, nx, ny - c)
-                    and _inside(grid, lo, cell, nx, ny + c)
+                    _inside(grid, glo, cell, nx - c, ny)
+                    and _inside(grid, glo, cell, nx + c, ny)
+                    and _inside(grid, glo, cell, nx, ny - c)
+                    and _inside(grid, glo, cell, nx, ny + c)
                 ):
                     continue
             elif dirs[s, 0] * ny - dirs[s, 1] * nx < clear * h:
@@ -264,7 +264,9 @@ def anneal_corner(
         if near:
             continue
         p[i, 0], p[i, 1] = nx, ny
-        s2, pen = region_score(p, ray, dirs, judged, grid, lo, cell, h, gap_lo, gap_hi, short, wide)
+        s2, pen = region_score(
+            p, ray, dirs, judged, grid, glo, cell, h, gap_lo, gap_hi, short, wide
+        )
         state, u = _next(state)
         if pen <= cap and (s2 < score or u < math.exp(-(s2 - score) / temp)):
             score = s2

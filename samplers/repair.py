@@ -1558,7 +1558,10 @@ def anneal_bad(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
     movable_free = np.r_[free, True][was]
     slid = np.r_[slide, False][was]
     anchored = np.r_[anchors, False][was]
-    frame = np.asarray(kwargs.get("frame", np.empty((0, 2))), dtype=np.float64).reshape(-1, 2)
+    frame = kwargs.get("frame")
+    frame = (
+        np.empty((0, 2)) if frame is None else np.asarray(frame, dtype=np.float64).reshape(-1, 2)
+    )
     try:
         tri = Delaunay(out.uv).simplices
     except QhullError:
