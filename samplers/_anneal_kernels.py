@@ -11,9 +11,7 @@ within its sector, an edge's sample along its edge), the Delaunay
 triangles of the region are made anew (:func:`delaunay_triangles`), and the
 move is kept by Metropolis' rule on the region's score (its worst ratio
 first).  The random numbers are the kernel's own (SplitMix64, Box-Muller),
-so that a seed gives the same moves with any numpy or numba.  Without rays
-the region is the plane round a point inside a face, cut to the face's
-raster (:func:`region_score`): :func:`sr33.samplers.repair.anneal_bad`.
+so that a seed gives the same moves with any numpy or numba.
 """
 
 from __future__ import annotations
@@ -52,10 +50,7 @@ def _normal(state):
 def _in_sector(dirs, x, y, clear):
     """Whether ``(x, y)`` lies in one of the sectors between consecutive rays
     ``dirs`` (counter-clockwise, each less than 180° wide) at least ``clear``
-    inside both of its rays; the sector's index, or -1.  No rays: the whole
-    plane, sector 0."""
-    if dirs.shape[0] == 0:
-        return 0
+    inside both of its rays; the sector's index, or -1."""
     for s in range(dirs.shape[0] - 1):
         if (
             dirs[s, 0] * y - dirs[s, 1] * x > clear
@@ -66,29 +61,7 @@ def _in_sector(dirs, x, y, clear):
 
 
 @njit(cache=True)
-def _inside(grid, lo, cell, x, y):
-    """Whether ``(x, y)`` falls in a True cell of ``grid`` (rows along y,
-    :class:`sr33.samplers.chart.Raster`'s); True for an empty grid."""
-    if grid.shape[0] == 0:
-        return True
-    i = math.floor((x - lo[0]) / cell)
-    j = math.floor((y - lo[1]) / cell)
-    if i < 0 or j < 0 or i >= grid.shape[1] or j >= grid.shape[0]:
-        return False
-    return grid[j, i]
-
-
-@njit(cache=True)
 def corner_score(pts, ray, dirs, judged, h, gap_lo, gap_hi, short, wide):
-    """:func:`region_score` of a corner's region, with no inside test."""
-    return region_score(
-        pts, ray, dirs, judged, np.zeros((0, 0), dtype=np.bool_), np.zeros(2), 1.0,
-        h, gap_lo, gap_hi, short, wide,
-    )  # fmt: skip
-
-
-@njit(cache=True)
-def region_score(pts, ray, dirs, judged, grid, glo, cell, h, gap_lo, gap_hi, short, wide):
     """The score of a corner's region ``pts`` ((m, 2), the corner at the
     origin): the worst ratio of its Delaunay triangles whose centroid lies
     within ``judged`` of the corner and in one of the sectors between its
@@ -99,10 +72,7 @@ def region_score(pts, ray, dirs, judged, grid, glo, cell, h, gap_lo, gap_hi, sho
     h, 10 per h of a gap between neighbours on one ray outside
     ``[gap_lo, gap_hi]`` h (``ray``: the ray a sample lies on, -2 for the
     corner, on all, -1 for none).  Both infinite where the points cannot
-    be triangulated.  Only the triangles whose centroid is inside the
-    raster ``grid`` (``glo``, ``cell``: :func:`_inside`) are judged; with no
-    rays the sectors are the whole plane (a region round a point inside a
-    face)."""
+    be triangulated."""
     got = delaunay_triangles(pts, 1e-9 * h * h, 1e-10 * h**4)
     if got is None:
         return np.inf, np.inf
@@ -115,8 +85,6 @@ def region_score(pts, ray, dirs, judged, grid, glo, cell, h, gap_lo, gap_hi, sho
         cx = (pts[a, 0] + pts[b, 0] + pts[c, 0]) / 3.0
         cy = (pts[a, 1] + pts[b, 1] + pts[c, 1]) / 3.0
         if cx * cx + cy * cy > judged * judged or _in_sector(dirs, cx, cy, 0.0) < 0:
-            continue
-        if not _inside(grid, glo, cell, cx, cy):
             continue
         la = math.hypot(pts[b, 0] - pts[c, 0], pts[b, 1] - pts[c, 1])
         lb = math.hypot(pts[c, 0] - pts[a, 0], pts[c, 1] - pts[a, 1])
@@ -171,9 +139,6 @@ def anneal_corner(
     moves,
     sigma,
     t0,
-    grid,
-    glo,
-    cell,
 ):
     """One seeded annealing of a corner's region (:func:`corner_score`; the
     corner at the origin).
@@ -188,14 +153,11 @@ def anneal_corner(
     temperature falling geometrically from ``t0`` to ``t0 / 1000``, on the
     ratio's part of the score; a move that makes the penalties' part exceed
     the start's is refused (the annealing trades no spacing for a ratio).
-    With no rays (a region round a point inside a face) a free sample moves
-    anywhere its points ``clear`` h aside along both axes stay inside the
-    raster ``grid``; triangles are judged on it (:func:`region_score`).
     Returns the best points met and their ratio score."""
     m = pts.shape[0]
     p = pts.copy()
     movable = np.flatnonzero(kind != FIXED)
-    score, cap = region_score(p, ray, dirs, judged, grid, glo, cell, h, gap_lo, gap_hi, short, wide)
+    score, cap = corner_score(p, ray, dirs, judged, h, gap_lo, gap_hi, short, wide)
     if movable.size == 0:
         return p, score
     cap += 1e-9
@@ -243,18 +205,9 @@ def anneal_corner(
             s = sector[i]
             if s < 0:
                 continue
-            if dirs.shape[0] == 0:
-                c = clear * h
-                if not (
-                    _inside(grid, glo, cell, nx - c, ny)
-                    and _inside(grid, glo, cell, nx + c, ny)
-                    and _inside(grid, glo, cell, nx, ny - c)
-                    and _inside(grid, glo, cell, nx, ny + c)
-                ):
-                    continue
-            elif dirs[s, 0] * ny - dirs[s, 1] * nx < clear * h:
+            if dirs[s, 0] * ny - dirs[s, 1] * nx < clear * h:
                 continue
-            elif nx * dirs[s + 1, 1] - ny * dirs[s + 1, 0] < clear * h:
+            if nx * dirs[s + 1, 1] - ny * dirs[s + 1, 0] < clear * h:
                 continue
         near = False
         for j in range(m):
@@ -264,9 +217,7 @@ def anneal_corner(
         if near:
             continue
         p[i, 0], p[i, 1] = nx, ny
-        s2, pen = region_score(
-            p, ray, dirs, judged, grid, glo, cell, h, gap_lo, gap_hi, short, wide
-        )
+        s2, pen = corner_score(p, ray, dirs, judged, h, gap_lo, gap_hi, short, wide)
         state, u = _next(state)
         if pen <= cap and (s2 < score or u < math.exp(-(s2 - score) / temp)):
             score = s2

@@ -49,16 +49,6 @@ class Raster:
     def __call__(self, pts: np.ndarray) -> np.ndarray:
         return grid_lookup(as_points(pts), self.lo, float(self.cell), self.grid)
 
-    def moved(self, origin: np.ndarray) -> Raster:
-        """The same test in coordinates whose zero is ``origin`` (the grid shared)."""
-        out = Raster.__new__(Raster)
-        out.lo, out.cell, out.grid = (
-            self.lo - np.asarray(origin, dtype=np.float64),
-            self.cell,
-            self.grid,
-        )
-        return out
-
 
 def as_points(p) -> np.ndarray:
     """``p`` as a C-contiguous (n, 2) float64 array (the kernels' input)."""

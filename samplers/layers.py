@@ -81,7 +81,6 @@ from .repair import (
     MOVABLE,
     RETRY_BAD,
     Repaired,
-    anneal_bad,
     anneal_corners,
     copies,
     glued,
@@ -729,7 +728,6 @@ def repair_planar_faces(
                 STUCK,
                 wide=bool(arcs) and all(a.closed for a in arcs),
                 shake=not further,
-                polish=True,
                 **args,
             )
         r = done[key]
@@ -799,7 +797,6 @@ def unstuck(
     stuck: float,
     wide: bool = True,
     shake: bool = True,
-    polish: bool = False,
     **kwargs,
 ):
     """A repair's answer ``first`` retried where it is stuck at or above
@@ -819,10 +816,8 @@ def unstuck(
     its chart, and to 0.979 by the geodesic check (its rim's ghost rows are
     not where the cone's rings will be).  Last, still stuck, its acute
     corners between straight edges are annealed
-    (:func:`sr33.samplers.repair.anneal_corners`), and (with ``polish``: a
-    planar face, whose chart is isometric) the free samples round each bad
-    triangle left (:func:`sr33.samplers.repair.anneal_bad`).  ``kwargs``
-    are the repair's own.
+    (:func:`sr33.samplers.repair.anneal_corners`).  ``kwargs`` are the
+    repair's own.
 
     The repair is a local search whose end hangs on its path: cutcube's
     face where the scoop's arc meets the cube's edge ended at 0.829 or at
@@ -853,8 +848,6 @@ def unstuck(
             r = shaken
     if r.worst >= stuck:
         r = anneal_corners(uv, free, h, r, **kwargs)  # r itself unless it beats it
-    if polish and r.worst >= stuck:
-        r = anneal_bad(uv, free, h, r, **kwargs)  # r itself unless it beats it
     return r
 
 

@@ -35,10 +35,7 @@ Delaunay triangle meets the condition with a margin:
   run again.
 * :func:`anneal_corners`, for a face left stuck near a corner below
   ``ACUTE`` degrees between two straight edges: the corner's samples
-  annealed, seeded (:mod:`sr33.samplers._anneal_kernels`);
-* :func:`anneal_bad`, for a planar face left stuck anywhere: the free
-  samples round each bad triangle annealed the same way, as they are and
-  with one sample added at the triangle.
+  annealed, seeded (:mod:`sr33.samplers._anneal_kernels`).
 
 The domain is 2-D (a planar face in plane coordinates).  Everything is
 numpy, with the Delaunay triangulation
@@ -62,7 +59,7 @@ from sr33 import libm
 from sr33.mesh import SQRT3_2, norm, triangle_ratios
 from sr33.progress import log
 
-from ._anneal_kernels import FIXED, FREE, ON_EDGE, anneal_corner, region_score
+from ._anneal_kernels import FIXED, FREE, ON_EDGE, anneal_corner, corner_score
 from ._delaunay_kernels import checkable, delaunay_triangles
 from ._descent_kernels import QHULL, descend
 from ._repair_kernels import (
@@ -1298,12 +1295,11 @@ def anneal_region(
     restarts: int = ANNEAL_RESTARTS,
     moves: int = ANNEAL_MOVES,
     sigma: float = ANNEAL_SIGMA,
-    inside: Raster | None = None,
 ) -> np.ndarray | None:
     """The best of ``restarts`` seeded annealings (seeds 0 on) of a corner's
-    region, or of a region round a point inside a face, each of ``moves``
-    moves of ``sigma`` h (:func:`sr33.samplers._anneal_kernels.anneal_corner`),
-    or None when none scores below the start.
+    region, each of ``moves`` moves of ``sigma`` h
+    (:func:`sr33.samplers._anneal_kernels.anneal_corner`), or None when
+    none scores below the start.
 
     Parameters
     ----------
@@ -1316,15 +1312,11 @@ def anneal_region(
         The ray each sample lies on (-2 the corner, -1 none).
     dirs : (k, 2) array_like of float
         The rays' unit directions, counter-clockwise, consecutive ones less
-        than 180° apart; the region is the sectors between them (none: the
-        whole plane, cut to ``inside``).
+        than 180° apart; the region is the sectors between them.
     h : float
         The sample spacing.
     restarts, moves, sigma
         The annealings' number, length and step.
-    inside : Raster, optional
-        The face's inside test, in the region's coordinates: only triangles
-        whose centroid it holds are judged, free samples stay in it.
 
     Returns
     -------
@@ -1338,11 +1330,7 @@ def anneal_region(
         return None
     judged = (ANNEAL_REACH + 1.2) * h
     bounds = (h, GAP[0], GAP[1], SHORT, WIDE)
-    if inside is None:
-        raster = (np.zeros((0, 0), dtype=np.bool_), np.zeros(2), 1.0)
-    else:
-        raster = (np.ascontiguousarray(inside.grid), inside.lo.astype(np.float64), inside.cell)
-    start = region_score(pts, ray, dirs, judged, *raster, *bounds)[0]
+    start = corner_score(pts, ray, dirs, judged, *bounds)[0]
     best, best_score = None, start
     for seed in range(restarts):
         p, score = anneal_corner(
@@ -1358,7 +1346,6 @@ def anneal_region(
             moves,
             sigma,
             ANNEAL_T0,
-            *raster,
         )
         if score < best_score:
             best, best_score = p, score
@@ -1510,121 +1497,4 @@ def anneal_corners(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
         if judged.worst < out.worst and (judged.bad <= out.bad or judged.worst < GOOD_ENOUGH):
             out = Repaired(uv=trial_uv, origin=out.origin, bad=judged.bad, worst=judged.worst)
             bad = None
-    return out
-
-
-def anneal_bad(uv, free, h: float, first: Repaired, **kwargs) -> Repaired:
-    """Anneal the free samples round each bad triangle a planar face's repair left.
-
-    The repair's descent and edits end where its path leads: conebox's top,
-    a square round the cone's base circle, ended at 0.843 or at 0.858 (one
-    triangle of a rim sample and two free ones) as the face's boundary
-    polygon was tessellated more or less finely, and 16 further rounds
-    stayed between 0.855 and 0.863.  Here, worst first, each triangle of
-    the answer above ``BAD`` whose centroid is no nearer than
-    ``ANNEAL_REACH`` h to one taken before is the centre of a region: the
-    free samples within ``ANNEAL_REACH`` h of it move, the other samples and
-    the frame within 3 h more stay
-    (:func:`anneal_region` with no rays, cut to the face by its raster:
-    triangles judged whose centroid lies in the face, free samples kept
-    ``ANNEAL_CLEAR`` h inside it).  The best run's points replace the
-    answer's when the whole face, judged like ``first``, has a lower worst
-    ratio and either no more bad triangles or none at or above
-    ``GOOD_ENOUGH`` (:func:`anneal_corners`' rule).  Only for a face whose
-    ``inside`` is a :class:`Raster` (a plane: its chart is isometric) and
-    that is no development (``turn``); else ``first``.
-
-    Parameters
-    ----------
-    uv, free, h
-        The input of ``first``'s :func:`repair`.
-    first : Repaired
-        Its answer.
-    **kwargs
-        The keyword arguments of that repair, passed on to the judging one.
-
-    Returns
-    -------
-    Repaired
-        ``first``, or a better answer whose ``origin`` refers to ``uv``.
-    """
-    raster = kwargs.get("inside")
-    if first.worst <= BAD or kwargs.get("turn") is not None or not isinstance(raster, Raster):
-        return first
-    uv, free, slide, anchors, inside, judge_kw = _corner_inputs(uv, free, kwargs)
-    n = uv.shape[0]
-    out = first
-    was = np.where(out.origin >= 0, out.origin, n)
-    movable_free = np.r_[free, True][was]
-    slid = np.r_[slide, False][was]
-    anchored = np.r_[anchors, False][was]
-    frame = kwargs.get("frame")
-    frame = (
-        np.empty((0, 2)) if frame is None else np.asarray(frame, dtype=np.float64).reshape(-1, 2)
-    )
-    try:
-        tri = Delaunay(out.uv).simplices
-    except QhullError:
-        return first
-    tri = tri[inside(out.uv[tri].mean(axis=1))]
-    rho = triangle_ratios(out.uv, tri)
-    order = np.flatnonzero(rho > BAD)
-    order = order[np.lexsort((order, -rho[order]))]
-    centres: list[np.ndarray] = []
-    for t in order:
-        c = out.uv[tri[t]].mean(axis=0)
-        if any(norm(c - q) < ANNEAL_REACH * h for q in centres):
-            continue
-        centres.append(c)
-    for c in centres:
-        if out.worst <= BAD:
-            break
-        trials = []
-        for added in (False, True):
-            # as it is, and with a free sample added at the centre (the
-            # annealing moves samples, it adds none: a region short of one
-            # stays stuck)
-            base = np.vstack([out.uv, c[None]]) if added else out.uv
-            origin = np.r_[out.origin, -1] if added else out.origin
-            can_move = np.r_[movable_free, True] if added else movable_free
-            dist = np.linalg.norm(base - c, axis=1)
-            local = np.flatnonzero(dist < (ANNEAL_REACH + 3.0) * h)
-            local = local[np.lexsort((base[local, 1], base[local, 0]))]
-            kind = np.full(local.size, FIXED, dtype=np.int64)
-            kind[(dist[local] < ANNEAL_REACH * h) & can_move[local]] = FREE
-            near_frame = frame[np.linalg.norm(frame - c, axis=1) < (ANNEAL_REACH + 3.0) * h]
-            pts = np.vstack([base[local], near_frame]) - c
-            kind = np.r_[kind, np.full(near_frame.shape[0], FIXED, dtype=np.int64)]
-            ray = np.full(pts.shape[0], -1, dtype=np.int64)
-            best = anneal_region(pts, kind, ray, np.empty((0, 2)), h, inside=raster.moved(c))
-            if best is None:
-                continue
-            trial_uv = base.copy()
-            trial_uv[local] = best[: local.size] + c
-            judged = repair(
-                trial_uv,
-                can_move,
-                h,
-                slide=np.r_[slid, False] if added else slid,
-                anchors=np.r_[anchored, False] if added else anchored,
-                **judge_kw,
-            )
-            log.debug(
-                "region annealed%s: %.4f (%d bad) against %.4f (%d bad)",
-                " with a sample added" if added else "",
-                judged.worst,
-                judged.bad,
-                out.worst,
-                out.bad,
-            )
-            trials.append((judged.worst, judged.bad, added, trial_uv, origin))
-        if not trials:
-            continue
-        worst, bad, _, trial_uv, origin = min(trials, key=lambda x: (x[0], x[1], x[2]))
-        if worst < out.worst and (bad <= out.bad or worst < GOOD_ENOUGH):
-            out = Repaired(uv=trial_uv, origin=origin, bad=bad, worst=worst)
-            n_free = out.uv.shape[0]
-            movable_free = np.r_[movable_free, True][:n_free]
-            slid = np.r_[slid, False][:n_free]
-            anchored = np.r_[anchored, False][:n_free]
     return out

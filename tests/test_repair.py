@@ -7,13 +7,11 @@ import pytest
 from scipy.spatial import Delaunay, cKDTree
 
 from sr33.mesh import triangle_ratios
-from sr33.samplers._anneal_kernels import corner_score, region_score
-from sr33.samplers.chart import Raster
+from sr33.samplers._anneal_kernels import corner_score
 from sr33.samplers.repair import (
     ANNEAL_REACH,
     BAD,
     SHORT,
-    anneal_bad,
     anneal_corners,
     repair,
     rotate,
@@ -787,80 +785,3 @@ def test_corner_score_is_the_worst_ratio_of_the_corners_delaunay_triangles():
     assert pen == pytest.approx(0.0, abs=1e-12)
     tight = corner_score(pts, ray, dirs, 4.0, 1.0, 0.75, 1.0, 0.0, 1e9)[1]
     assert tight == pytest.approx(10.0 * 2 * 0.1, abs=1e-9)  # the 1.1 gap on each ray
-
-
-def _holed_square(h: float, radius: float):
-    """A unit square round the origin less a disc of ``radius`` at the origin:
-    its lattice (free) and rim (fixed) samples and its inside test."""
-    uv, rim = hole_layout(h, radius, np.zeros(2))
-    corners = np.array([(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]) * (1 + h)
-    t = np.linspace(0.0, 2 * np.pi, 181)
-    circle = radius * np.stack([np.cos(t), np.sin(t)], 1)
-    seg = np.concatenate(
-        [
-            np.stack([corners, np.roll(corners, -1, axis=0)], 1),
-            np.stack([circle[:-1], circle[1:]], 1),
-        ]
-    )
-    return uv, ~rim, Raster(seg, h / 8)
-
-
-def test_region_score_judges_the_triangles_inside_the_raster():
-    """With no rays the annealing's region is the plane cut to the face's
-    raster: its score is the worst ratio of the Delaunay triangles whose
-    centroid lies in the face (not in its hole) and near the centre, as
-    scipy's triangulation has them."""
-    h = 0.1
-    uv, _, raster = _holed_square(h, 0.2)
-    rng = np.random.default_rng(3)
-    pts = uv + rng.normal(0.0, 0.12 * h, uv.shape)
-    centre = np.array([0.25, 0.0])
-    local = pts - centre
-    ray = np.full(len(pts), -1, dtype=np.int64)
-    moved = raster.moved(centre)
-    judged = 3.0 * h
-    score, pen = region_score(
-        local, ray, np.empty((0, 2)), judged, moved.grid, moved.lo, moved.cell,
-        h, 0.75, 1.35, 0.0, 1e9,
-    )  # fmt: skip
-    tri = Delaunay(local).simplices
-    c = local[tri].mean(axis=1)
-    keep = (np.linalg.norm(c, axis=1) <= judged) & raster(c + centre)
-    rho = triangle_ratios(local, tri[keep])
-    assert 5 < keep.sum() < len(tri)
-    assert not raster(np.zeros((1, 2)) + 0.0)[0]  # the hole is outside
-    assert score == pytest.approx(rho.max() + 0.2 * np.clip(rho - 0.8, 0, None).sum(), abs=1e-12)
-    assert pen == pytest.approx(0.0, abs=1e-12)
-
-
-def test_anneal_bad_mends_a_bad_triangle_away_from_any_corner():
-    """A square lattice whose boundary samples are fixed, one free sample
-    pushed 0.45 h towards its neighbour: judged without descent or edits,
-    the face has a triangle above 0.85 in its middle, far from any corner.
-    Annealing the free samples round it takes the worst ratio below
-    ``BAD``; the fixed samples stay, every moved sample stays in the face
-    and at least ``SHORT`` h from the others, and the answer is the same
-    every time."""
-    h = 0.1
-    xs = np.arange(-0.5, 0.5 + 1e-9, h)
-    uv = np.stack(np.meshgrid(xs, xs), -1).reshape(-1, 2)
-    free = (np.abs(uv) < 0.5 - 1e-9).all(axis=1)
-    corners = np.array([(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]) * (1 + 1e-6)
-    raster = Raster(np.stack([corners, np.roll(corners, -1, axis=0)], 1), h / 8)
-    kw = dict(inside=raster, descent_steps=0, max_edits=0)
-    assert repair(uv, free, h, **kw).worst < 0.75  # the lattice: 1/sqrt(2)
-    pushed = int(np.argmin(np.linalg.norm(uv - (0.2, -0.1), axis=1)))
-    uv[pushed, 0] += 0.45 * h
-    first = repair(uv, free, h, **kw)
-    assert first.worst > 0.85
-    annealed = anneal_bad(uv, free, h, first, **kw)
-    assert annealed.worst < BAD < first.worst
-    kept = annealed.origin >= 0
-    assert (annealed.uv[kept][~free[annealed.origin[kept]]] == uv[~free]).all()
-    moved = np.flatnonzero((annealed.uv[: len(first.uv)] != first.uv).any(axis=1))
-    assert moved.size and raster(annealed.uv[moved]).all()
-    assert cKDTree(annealed.uv).query(annealed.uv[moved], k=2)[0][:, 1].min() >= SHORT * h - 1e-9
-    again = anneal_bad(uv, free, h, first, **kw)
-    assert again.uv.tobytes() == annealed.uv.tobytes()
-    # a chart that is not a raster (a development, a map): nothing to do
-    assert anneal_bad(uv, free, h, first, inside=lambda c: raster(c)) is first
