@@ -727,6 +727,28 @@ def test_shapes_meet_condition_iii(checked, name):
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("cutcube")
+@pytest.mark.xfail(
+    strict=True,
+    reason="stop 68: cutcube at 6,000 samples (its default spacing gives 7,523) has 71 "
+    "samples breaking III-ii (0.9925) on ab3a146 as on 2eb9864, on the three cube faces "
+    "the scoop cuts (x, y, z = 0.5); issue 23 asks the margin of the defaults only",
+)
+def test_regression_cutcube_at_6000_samples_meets_condition_iii():
+    """A library shape sampled at a density other than its default keeps
+    Condition III-ii with the margin, as a user choosing ``target_points``
+    expects (the general sampler's promise); cutcube at 6,000 does not."""
+    pytest.importorskip("potpourri3d")
+    from sr33.validators.conditions import sample_conditions
+
+    s = shapes.build("cutcube")
+    r = scan(s, target_points=6000)
+    rep = sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    assert rep.max_degree <= 33
+    assert rep.worst_ratio.max() <= 0.85
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "name",
     [pytest.param(n, marks=pytest.mark.xdist_group(n)) for n in ("hexagonal_prism", "fillet_box")],
