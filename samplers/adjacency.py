@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from sr33.mesh import norm
+
 
 def face_index(face, faces) -> int:
     """Index of ``face`` in ``faces`` (same TShape and location), -1 if absent."""
@@ -51,6 +53,7 @@ class EdgeFaces:
             self.faces_of.append(uniq)
             self.uses.append(len(adj))
         self._bends: dict[int, float | None] = {}
+        self._straight: dict[float, tuple[dict, dict]] = {}
 
     def index(self, edge) -> int:
         """Position of ``edge`` in :attr:`edges` (-1 if it bounds no face)."""
@@ -84,6 +87,25 @@ class EdgeFaces:
                 out = float(np.dot(n1, n2))
             self._bends[k] = out
         return self._bends[k]
+
+    def straight(self, tol: float) -> tuple[dict, dict]:
+        """The straight edges longer than ``tol`` (edge index -> start, unit
+        direction, length) and, per face, its straight edges' indices;
+        computed once per ``tol`` (the scan's strip rows and its edges'
+        followers read the same table: not to be modified)."""
+        if tol not in self._straight:
+            lines: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
+            for ei, e in enumerate(self.edges):
+                if e.geomType() == "LINE" and e.Length() > tol:
+                    a = np.array(e.startPoint().toTuple())
+                    b = np.array(e.endPoint().toTuple())
+                    lines[ei] = (a, (b - a) / norm(b - a), float(norm(b - a)))
+            by_face: dict[int, list[int]] = {}
+            for ei in lines:
+                for k in self.faces_of[ei]:
+                    by_face.setdefault(k, []).append(ei)
+            self._straight[tol] = (lines, by_face)
+        return self._straight[tol]
 
     def folded(self, degrees: float) -> set[tuple[int, int]]:
         """Pairs of faces (both orders) that meet along an edge where the

@@ -406,7 +406,7 @@ def _strip_rows(ef: EdgeFaces, lines, by_face, dirs: np.ndarray, fam: list[int],
     it put one sample on each of the edges' columns).
 
     ``lines`` and ``by_face`` are the shape's straight edges
-    (:func:`_straight_edges`); a face's are tried longest first (the first
+    (:meth:`EdgeFaces.straight`); a face's are tried longest first (the first
     in the shape's edge order on a tie).  Returns the directions (``dirs``
     with new ones appended, one shared by strips parallel to each other),
     each face's direction index, and per strip its two edges (face index ->
@@ -452,7 +452,7 @@ def _strip_rows(ef: EdgeFaces, lines, by_face, dirs: np.ndarray, fam: list[int],
 
 def _parallel_gap(lines, e1: int, e2: int) -> float | None:
     """How far apart the lines of two straight edges run (``lines`` from
-    :func:`_straight_edges`); None where they are not parallel."""
+    :meth:`EdgeFaces.straight`); None where they are not parallel."""
     a1, u1, _ = lines[e1]
     a2, u2, _ = lines[e2]
     if abs(abs(float(dot(u1, u2))) - 1.0) > 1e-9:
@@ -1087,22 +1087,6 @@ def _feature_samples(
     return pts, fid, np.array(dense, dtype=np.float64).reshape(-1, 3), lattices
 
 
-def _straight_edges(ef: EdgeFaces, tol: float):
-    """The shape's straight edges longer than ``tol`` (edge index -> start,
-    unit direction, length) and, per face, its straight edges' indices."""
-    lines: dict[int, tuple[np.ndarray, np.ndarray, float]] = {}
-    for ei, e in enumerate(ef.edges):
-        if e.geomType() == "LINE" and e.Length() > tol:
-            a = np.array(e.startPoint().toTuple())
-            b = np.array(e.endPoint().toTuple())
-            lines[ei] = (a, (b - a) / norm(b - a), float(norm(b - a)))
-    by_face: dict[int, list[int]] = {}
-    for ei in lines:
-        for k in ef.faces_of[ei]:
-            by_face.setdefault(k, []).append(ei)
-    return lines, by_face
-
-
 def _strip_followers(ef: EdgeFaces, width: float, tol: float, banded=()) -> dict[int, int]:
     """Straight edges that follow another across a narrow planar strip
     (edge index -> the edge it follows).
@@ -1121,7 +1105,7 @@ def _strip_followers(ef: EdgeFaces, width: float, tol: float, banded=()) -> dict
     had each end's edge follow its chamfer's other edge, half a step off
     the end's columns: 171 samples of each end at ratio 1.0)."""
     out: dict[int, int] = {}
-    lines, by_face = _straight_edges(ef, tol)
+    lines, by_face = ef.straight(tol)
     for k, mine in sorted(by_face.items()):
         face = ef.faces[k]
         if face.geomType() != "PLANE" or len(mine) < 2 or k in banded:
@@ -1172,7 +1156,7 @@ def _side_followers(
     followed, across a strip) and faces in ``banded`` are left alone."""
     out: dict[int, int] = {}
     busy = set(taken or {}) | set((taken or {}).values())
-    lines, by_face = _straight_edges(ef, tol)
+    lines, by_face = ef.straight(tol)
     held: dict[tuple[int, int], bool] = {}
     leads: set[int] = set()
 
@@ -1422,7 +1406,7 @@ def scan(
         tol = 1e-7 * size
         fam = [_face_family(f, dirs, size / 200) for f in faces]
         edge_faces = EdgeFaces(occ)
-        lines, by_face = _straight_edges(edge_faces, tol)
+        lines, by_face = edge_faces.straight(tol)
         dirs, fam, strips = _strip_rows(edge_faces, lines, by_face, dirs, fam, h)
         corner = _box_corners(lo, hi)
 

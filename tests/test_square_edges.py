@@ -186,7 +186,7 @@ def test_a_chamfer_two_h_wide_slanted_to_the_rows_is_scanned_along_its_edges():
 
     from sr33.samplers.adjacency import EdgeFaces
     from sr33.samplers.faces import steps
-    from sr33.samplers.scanline import _straight_edges, _strip_rows
+    from sr33.samplers.scanline import _strip_rows
     from sr33.validators.conditions import sample_conditions
 
     ring = [(0.569, -0.288), (-0.02, 0.6375), (-0.638, 0.0), (0.0036, -0.638)]
@@ -234,7 +234,7 @@ def test_a_chamfer_two_h_wide_slanted_to_the_rows_is_scanned_along_its_edges():
     assert strips == 4
     # a strip wider than three spacings, or narrower than two clearances, keeps its family
     ef = EdgeFaces(s.solid)
-    lines, by_face = _straight_edges(ef, 1e-9)
+    lines, by_face = ef.straight(1e-9)
     for h_try in (width / 3.2, width / 1.3):
         same, fam, held = _strip_rows(ef, lines, by_face, np.eye(3), [0] * len(faces), h_try)
         assert same.shape == (3, 3) and fam == [0] * len(faces) and not held
