@@ -33,6 +33,7 @@ from sr33.mesh import SQRT3_2, dot, norm, triangle_ratios
 from sr33.progress import log
 
 from . import _line_kernels as line_kernels
+from ._fan_kernels import fan_figures, uneven_figures
 from .adjacency import EdgeFaces
 from .chart import (
     Arc,
@@ -1621,15 +1622,15 @@ def _fan_figures(radii: np.ndarray, phi):
     Condition III-ii ratio of their triangles, the largest sum of the two
     angles opposite a spoke (a spoke is a Delaunay edge while it stays below
     π) and the shortest chord between neighbouring spokes' ends."""
-    a, b = radii, np.roll(radii, -1, axis=1)  # spoke k and spoke k + 1
-    c = np.sqrt(a * a + b * b - 2 * a * b * np.cos(phi))
-    side = np.sort(np.stack([a, b, c], axis=2), axis=2)
-    ratio = (side[..., 1] / side[..., 2]).max(axis=1)
-    # in triangle (apex, k, k + 1): the angle at k + 1 faces spoke k, the one at k faces k + 1
-    at_next = libm.arccos(np.clip((b * b + c * c - a * a) / (2 * b * c), -1, 1))
-    at_this = libm.arccos(np.clip((a * a + c * c - b * b) / (2 * a * c), -1, 1))
-    opposite = at_next + np.roll(at_this, 1, axis=1)  # both triangles on spoke k
-    return ratio, np.degrees(opposite.max(axis=1)), c.min(axis=1)
+    radii = np.ascontiguousarray(radii, dtype=np.float64)
+    phi = np.ascontiguousarray(np.broadcast_to(np.asarray(phi, dtype=np.float64), radii.shape))
+    return _fan_columns(fan_figures(radii, phi))
+
+
+def _fan_columns(figures: np.ndarray):
+    """The (ratio, angle sum in degrees, chord) of :func:`_fan_figures` from
+    a kernel's columns (the angle sum in radians)."""
+    return figures[:, 0], np.degrees(figures[:, 1]), figures[:, 2]
 
 
 @dataclass(frozen=True)
@@ -1713,14 +1714,15 @@ def _uneven_fan(theta: float) -> Fan | None:
     grid = np.round(np.arange(0.40, 1.0001, 0.02), 2)
     r2, r3 = (x.ravel() for x in np.meshgrid(grid, grid, indexing="ij"))
     # every gap pair with every pair of lengths (gaps outer, lengths inner)
-    phi = np.stack([g1, g2, theta - g1 - g2], axis=1).repeat(r2.size, axis=0)
-    radii = np.tile(np.stack([np.ones(r2.size), r2, r3], axis=1), (g1.size, 1))
-    ratio, angles, chord = _fan_figures(radii, phi)
+    ratio, angles, chord = _fan_columns(uneven_figures(g1, g2, theta, r2, r3))
     ok = np.flatnonzero((ratio < FAN_RATIO) & (angles < FAN_ANGLES) & (chord >= FAN_CHORD))
     if ok.size == 0:
         return None
     i = ok[np.argmin(ratio[ok])]
-    return Fan(radii=radii[i], at=np.r_[0.0, np.cumsum(phi[i, :2])] / theta)
+    pair, length = divmod(int(i), r2.size)
+    phi = np.array([g1[pair], g2[pair], theta - g1[pair] - g2[pair]])
+    radii = np.array([1.0, r2[length], r3[length]])
+    return Fan(radii=radii, at=np.r_[0.0, np.cumsum(phi[:2])] / theta)
 
 
 def _repair_developed(

@@ -949,6 +949,51 @@ def test_apex_fans_meet_condition_iii_with_their_spokes_delaunay():
     np.testing.assert_allclose(fan.at * 126.0, [0.0, 82.0, 104.0])
 
 
+def _fan_figures_by_numpy(radii, phi):
+    """The figures of fans as numpy expressions over all of them (the form
+    the kernels of ``samplers._fan_kernels`` replaced)."""
+    from sr33 import libm
+
+    a, b = radii, np.roll(radii, -1, axis=1)
+    c = np.sqrt(a * a + b * b - 2 * a * b * np.cos(phi))
+    side = np.sort(np.stack([a, b, c], axis=2), axis=2)
+    ratio = (side[..., 1] / side[..., 2]).max(axis=1)
+    at_next = libm.arccos(np.clip((b * b + c * c - a * a) / (2 * b * c), -1, 1))
+    at_this = libm.arccos(np.clip((a * a + c * c - b * b) / (2 * a * c), -1, 1))
+    opposite = at_next + np.roll(at_this, 1, axis=1)
+    return ratio, np.degrees(opposite.max(axis=1)), c.min(axis=1)
+
+
+@pytest.mark.parametrize("spokes", [2, 3, 4, 5])
+def test_fan_kernels_give_the_numpy_figures_bit_for_bit(spokes):
+    """The fan search's kernels (``_fan_figures`` and the uneven search's
+    rows) give the very bits of the numpy form, on random fans and on the
+    uneven search's grid: the fan chosen cannot depend on which form ran."""
+    import math
+
+    from sr33.samplers._fan_kernels import uneven_figures
+    from sr33.samplers.layers import _fan_figures
+
+    rng = np.random.default_rng(spokes)
+    radii = np.c_[np.ones(4000), rng.uniform(0.4, 1.0, (4000, spokes - 1))]
+    phi = rng.uniform(0.1, 2 * math.pi / spokes, (4000, spokes))
+    for got, want in zip(_fan_figures(radii, phi), _fan_figures_by_numpy(radii, phi)):
+        assert np.array_equal(got, want)
+    theta = 0.6 + spokes * 0.25  # developments of 49 to 109 degrees
+    for got, want in zip(
+        _fan_figures(radii, theta / spokes), _fan_figures_by_numpy(radii, theta / spokes)
+    ):
+        assert np.array_equal(got, want)
+    g1, g2 = (x.ravel() for x in np.meshgrid(np.linspace(0.1, 0.5, 7), np.linspace(0.1, 0.4, 5)))
+    r2, r3 = (x.ravel() for x in np.meshgrid(np.linspace(0.4, 1, 9), np.linspace(0.4, 1, 8)))
+    rows = uneven_figures(g1, g2, theta, r2, r3)
+    phi = np.stack([g1, g2, theta - g1 - g2], axis=1).repeat(r2.size, axis=0)
+    radii = np.tile(np.stack([np.ones(r2.size), r2, r3], axis=1), (g1.size, 1))
+    ratio, angles, chord = _fan_figures_by_numpy(radii, phi)
+    assert np.array_equal(rows[:, 0], ratio) and np.array_equal(rows[:, 2], chord)
+    assert np.array_equal(np.degrees(rows[:, 1]), angles)
+
+
 @pytest.mark.slow
 def test_partial_spheres_with_sharp_rims_are_repaired(sampled):
     """cutcube's scoop (three sharp circular rims) is repaired on its
