@@ -79,3 +79,46 @@ def test_meridian_rows_of_a_partial_sphere_are_h_apart_along_it():
     np.testing.assert_allclose(np.diff(flat), hf)
     psi_flat = np.arccos(np.clip((centre[2] - flat) / radius, -1, 1))
     assert (np.diff(psi_flat) * radius).max() > 1.5 * hf  # the family's planes graze the pole
+
+
+def _great_circle_ratio(p: np.ndarray, tri, radius: float) -> float:
+    """Condition III-ii's ratio of the triangle ``tri`` of points on a
+    sphere of ``radius`` about the origin, its sides along great circles."""
+    a, b, c = (p[i] for i in tri)
+    chords = np.array([np.linalg.norm(a - b), np.linalg.norm(b - c), np.linalg.norm(c - a)])
+    side = np.sort(2 * radius * np.arcsin(chords / (2 * radius)))
+    return side[1] / side[2]
+
+
+def test_sphere_worst_judges_both_diagonals_of_a_cocircular_quad():
+    """Four samples on one circle of the sphere: either diagonal is
+    Delaunay, and a check on another triangulation of the sphere may take
+    either, so ``sphere_worst`` judges the worse; pulled off the circle,
+    only the Delaunay diagonal's triangles count.  The far point (the
+    antipode) makes the hull solid; its facets' chords are over 2.5 h."""
+    from sr33.samplers.spheres import sphere_worst
+
+    radius, h, rho = 20.0, 1.0, 1.2
+    z0 = math.sqrt(radius**2 - rho**2)
+    ang = np.radians([0.0, 90.0, 140.0, 250.0])
+    quad = np.c_[rho * np.cos(ang), rho * np.sin(ang), np.full(4, z0)]
+    far = [0.0, 0.0, -radius]
+    pts = np.vstack([quad, far])
+    by_02 = max(_great_circle_ratio(pts, t, radius) for t in ((0, 1, 2), (0, 2, 3)))
+    by_13 = max(_great_circle_ratio(pts, t, radius) for t in ((1, 2, 3), (1, 3, 0)))
+    assert abs(by_02 - by_13) > 0.03  # the two diagonals judge differently
+    got = sphere_worst(pts, np.zeros(3), radius, h)
+    assert got == pytest.approx(max(by_02, by_13), abs=1e-12)
+    # corner 0 pulled towards the circle's centre (along the sphere): inside
+    # the circle through 1, 2, 3, so the diagonal 0-2 is Delaunay and the
+    # other is no triangle of the sphere
+    d = np.array([rho * 0.6, 0.0, 0.0])
+    p0 = d + np.array([0.0, 0.0, math.sqrt(radius**2 - d @ d)])
+    pulled = np.vstack([p0, quad[1:], far])
+    want = max(_great_circle_ratio(pulled, t, radius) for t in ((0, 1, 2), (0, 2, 3)))
+    other = max(_great_circle_ratio(pulled, t, radius) for t in ((1, 2, 3), (1, 3, 0)))
+    assert abs(want - other) > 0.03
+    assert sphere_worst(pulled, np.zeros(3), radius, h) == pytest.approx(want, abs=1e-12)
+    # fewer than four points, or all on one circle (flat): nothing to judge
+    assert sphere_worst(quad[:3], np.zeros(3), radius, h) == 0.0
+    assert sphere_worst(quad, np.zeros(3), radius, h) == 0.0
