@@ -13,7 +13,11 @@ face lies within 37° of its centre), and it maps circles to circles: the
 rims stay circular arcs, along which :func:`sr33.samplers.layers.arc_clamp` keeps
 the free samples on the face.  There the face is repaired like a planar
 one (:func:`sr33.samplers.repair.repair`): the rims' samples fixed, every other
-sample of the face free.
+sample of the face free.  The map's triangles are not quite the sphere's
+(the scale changes across them, and where four samples are nearly
+cocircular either diagonal is Delaunay): the answer is judged again on
+the sphere itself (:func:`sphere_worst`), and repaired from shaken starts
+where that verdict is not clear of the margin.
 
 CadQuery and OCP are imported when the functions run.
 """
