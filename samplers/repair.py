@@ -1045,16 +1045,28 @@ def _shake(prob: _Problem, attempt: int, only=None) -> None:
     a square of half-side 0.03 h times 1 to 5, ``attempt`` modulo 5: the
     same on every machine); with ``only`` (sample ids, ascending) those of
     them only, by offsets of another seeded stream."""
-    rng = np.random.default_rng(attempt if only is None else (LOCAL_SEED, attempt))
     free = np.flatnonzero(prob.free)
     if only is not None:
         free = np.intersect1d(free, only)
     size = 0.03 * ((attempt - 1) % 5 + 1) * prob.h
-    prob.uv[free] += (rng.random((free.size, 2)) * 2.0 - 1.0) * size
-    if prob.clamp is not None and free.size:
-        prob.uv[free] = prob.clamp(prob.uv[free])
+    shake(prob.uv, free, attempt if only is None else (LOCAL_SEED, attempt), size, prob.clamp)
     if prob.turn is not None and free.size:
         prob.uv[free] = prob.wrap(prob.uv[free])
+
+
+def shake(uv: np.ndarray, which, seed, size: float, clamp=None) -> None:
+    """Move the samples ``which`` (indices or a mask) of ``uv`` in place by
+    offsets uniform in a square of half-side ``size``, drawn from numpy's
+    generator seeded with ``seed`` (the same on every machine), then through
+    ``clamp`` (a repair's, keeping free samples on the face) when given: the
+    shaken starts of the repair's further attempts, and of a repair tried
+    again by a verdict the repair does not see (a partial sphere's,
+    :func:`sr33.samplers.spheres.repair_sphere_face`)."""
+    rng = np.random.default_rng(seed)
+    count = int(np.count_nonzero(which)) if np.asarray(which).dtype == bool else len(which)
+    uv[which] += (rng.random((count, 2)) * 2.0 - 1.0) * size
+    if clamp is not None and count:
+        uv[which] = clamp(uv[which])
 
 
 def _edited(prob: _Problem, edits) -> _Problem:

@@ -386,7 +386,7 @@ def _face_columns(face, anchor, axis_steps, ratio: float, h: float, tol: float):
     return own_anchor, own_steps
 
 
-def _strip_rows(ef: EdgeFaces, lines, by_face, dirs: np.ndarray, fam: list[int], h: float):
+def _strip_rows(ef: EdgeFaces, dirs: np.ndarray, fam: list[int], h: float, tol: float):
     """Scan directions with a narrow planar strip's rows along its edges.
 
     A planar face between two parallel straight edges, its corners all
@@ -405,15 +405,15 @@ def _strip_rows(ef: EdgeFaces, lines, by_face, dirs: np.ndarray, fam: list[int],
     direction keeps it (a chamfer on an axis-aligned box: its rows across
     it put one sample on each of the edges' columns).
 
-    ``lines`` and ``by_face`` are the shape's straight edges
-    (:meth:`EdgeFaces.straight`); a face's are tried longest first (the first
-    in the shape's edge order on a tie).  Returns the directions (``dirs``
-    with new ones appended, one shared by strips parallel to each other),
-    each face's direction index, and per strip its two edges (face index ->
-    (longer, other), edge indices).
+    A face's straight edges longer than ``tol`` (:meth:`EdgeFaces.straight`)
+    are tried longest first (the first in the shape's edge order on a tie).
+    Returns the directions (``dirs`` with new ones appended, one shared by
+    strips parallel to each other), each face's direction index, and per
+    strip its two edges (face index -> (longer, other), edge indices).
     """
     out, fam = [np.asarray(d, dtype=float) for d in dirs], list(fam)
     strips = {}
+    lines, by_face = ef.straight(tol)
     for fi, face in enumerate(ef.faces):
         if face.geomType() != "PLANE":
             continue
@@ -461,7 +461,7 @@ def _parallel_gap(lines, e1: int, e2: int) -> float | None:
 
 
 def _strip_planes(
-    strips, ef: EdgeFaces, lines, planes: list, h: float
+    strips, ef: EdgeFaces, planes: list, h: float, tol: float
 ) -> dict[int, tuple[float, float]]:
     """The first plane and spacing of each narrow strip's rows
     (:func:`_strip_rows`): anchored on its two edges, the width divided into
@@ -476,8 +476,9 @@ def _strip_planes(
     1.4 by 0.8 (ratio 0.87); without it they are 1.4 by 1.6 (0.75).  The
     step along is that of the first of the two edges (the longer first)
     whose faces across hold rows crossing it, else the longer's equal
-    steps."""
+    steps.  ``tol``: the straight edges' length bound, as for the strips."""
     out = {}
+    lines = ef.straight(tol)[0]
     for fi, (e1, e2) in sorted(strips.items()):
         d = planes[fi][0]
         along = None
@@ -1406,8 +1407,7 @@ def scan(
         tol = 1e-7 * size
         fam = [_face_family(f, dirs, size / 200) for f in faces]
         edge_faces = EdgeFaces(occ)
-        lines, by_face = edge_faces.straight(tol)
-        dirs, fam, strips = _strip_rows(edge_faces, lines, by_face, dirs, fam, h)
+        dirs, fam, strips = _strip_rows(edge_faces, dirs, fam, h, tol)
         corner = _box_corners(lo, hi)
 
         # rows along a coordinate axis: r times that axis's plane spacing
@@ -1432,7 +1432,7 @@ def scan(
             t0, hf = aligned[fi]
             crosses.append(_cross_lattice(face, d, hf, ratio, columns[fi][0], tol))
             planes.append((d, t0, hf, _columns(face, d, hf, ratio, *columns[fi], crosses[fi])))
-        for fi, (t0, hf) in _strip_planes(strips, edge_faces, lines, planes, h).items():
+        for fi, (t0, hf) in _strip_planes(strips, edge_faces, planes, h, tol).items():
             d = planes[fi][0]
             crosses[fi] = _cross_lattice(faces[fi], d, hf, ratio, columns[fi][0], tol)
             planes[fi] = (d, t0, hf, _columns(faces[fi], d, hf, ratio, *columns[fi], crosses[fi]))

@@ -42,7 +42,7 @@ from .faces import (
     rims_sampled,
 )
 from .layers import POLE_GOOD, RASTER, unstuck
-from .repair import repair
+from .repair import repair, shake
 from .samples import Samples
 
 FRAME_REACH = 2.5  # the neighbours' samples this near a rim (times h) frame the repair
@@ -235,20 +235,19 @@ def repair_sphere_face(fi: int, face, s: Samples, h: float, size: float, fixed=N
     # sphere's where four samples are nearly cocircular, and the scale
     # changes across a triangle (cutcube turned b: 0.825 on the map, 0.851
     # geodesically, 2 to 3 h inside the rims)
-    worst = sphere_worst(to2d.inverse(r.uv), centre, radius, h)
-    clamp = args["clamp"]
+    xyz = to2d.inverse(r.uv)
+    worst = sphere_worst(xyz, centre, radius, h)
     for k in range(1, SPHERE_TRIES + 1):
         if worst < SPHERE_GOOD:
             break
-        rng = np.random.default_rng((SPHERE_SEED, k))
         start = uv.copy()
-        start[free] += (rng.random((int(free.sum()), 2)) * 2.0 - 1.0) * (SPHERE_SHAKE * k * h)
-        start[free] = clamp(start[free])
+        shake(start, free, (SPHERE_SEED, k), SPHERE_SHAKE * k * h, args["clamp"])
         again = unstuck(start, free, h, repair(start, free, h, **args), MAP_GOOD, **args)
-        w = sphere_worst(to2d.inverse(again.uv), centre, radius, h)
+        again_xyz = to2d.inverse(again.uv)
+        w = sphere_worst(again_xyz, centre, radius, h)
         if (w, again.worst) < (worst, r.worst):
-            r, worst = again, w
-    return s.put(idx, r, to2d.inverse(r.uv), fi, "sphere")
+            r, xyz, worst = again, again_xyz, w
+    return s.put(idx, r, xyz, fi, "sphere")
 
 
 def sphere_worst(points: np.ndarray, centre: np.ndarray, radius: float, h: float) -> float:
@@ -278,22 +277,22 @@ def sphere_worst(points: np.ndarray, centre: np.ndarray, radius: float, h: float
     kept = chord.max(axis=1) < 2.5 * h
     if not kept.any():
         return 0.0
-    judged = [tri[kept]]
-    # each kept facet's sides shared with a kept facet: (a, b) the side,
-    # c the facet's corner facing it, d the neighbour's
-    t, k = np.nonzero(kept[:, None] & kept[nbr])
+    # each side shared by two kept facets, once: (a, b) the side, c the
+    # corner facing it in the facet, d the one in its neighbour
+    t, k = np.nonzero(kept[:, None] & kept[nbr] & (nbr > np.arange(tri.shape[0])[:, None]))
     n = nbr[t, k]
     c = tri[t, k]
     a, b = tri[t, (k + 1) % 3], tri[t, (k + 2) % 3]
     other = tri[n]
     d = other[(other != a[:, None]) & (other != b[:, None])]
+    chords = [chord[kept]]
     if d.size == a.size:  # (a degenerate hull could share more than a side)
         facing = _angle(p[c], p[a], p[b]) + _angle(p[d], p[a], p[b])
         near = np.abs(facing - math.pi) < COCIRCULAR
-        judged += [np.stack([a, c, d], axis=1)[near], np.stack([b, c, d], axis=1)[near]]
-    tri = np.concatenate(judged)
-    chord = norm(p[tri] - p[np.roll(tri, 1, axis=1)])
-    half = np.minimum(chord / (2.0 * radius), 1.0)  # the sine of half the arc's angle
+        flipped = np.concatenate([np.stack([a, c, d], axis=1), np.stack([b, c, d], axis=1)])
+        flipped = flipped[np.concatenate([near, near])]
+        chords.append(norm(p[flipped] - p[np.roll(flipped, 1, axis=1)]))
+    half = np.minimum(np.concatenate(chords) / (2.0 * radius), 1.0)  # sine of half the arc
     arc = 2.0 * radius * libm.arctan2(half, np.sqrt(1.0 - half * half))
     side = np.sort(arc, axis=1)
     return float((side[:, 1] / side[:, 2]).max())

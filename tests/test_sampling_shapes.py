@@ -728,14 +728,14 @@ def test_shapes_meet_condition_iii(checked, name):
 
 @pytest.fixture(scope="module")
 def cutcube_6000():
-    """cutcube sampled at 6,000 samples (its default spacing gives 7,523)
-    and its geodesic Condition III report."""
+    """The geodesic Condition III report of cutcube sampled at 6,000
+    samples (its default spacing gives 7,523)."""
     pytest.importorskip("potpourri3d")
     from sr33.validators.conditions import sample_conditions
 
     s = shapes.build("cutcube")
     r = scan(s, target_points=6000)
-    return r, sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
+    return sample_conditions(r.points, s.truth_vertices, s.truth_triangles)
 
 
 @pytest.mark.slow
@@ -747,7 +747,7 @@ def test_cutcube_at_6000_samples_keeps_condition_iii(cutcube_6000):
     whose lattices stagger against the edges' samples there; a face with
     an arc had its square edges left out of the repair (stop 69: 0.8565,
     none breaking III-ii)."""
-    r, rep = cutcube_6000
+    rep = cutcube_6000
     assert rep.max_degree <= 33
     assert rep.worst_ratio.max() < np.sqrt(3) / 2
 
@@ -763,7 +763,7 @@ def test_cutcube_at_6000_samples_keeps_condition_iii(cutcube_6000):
 def test_regression_cutcube_at_6000_samples_meets_condition_iii(cutcube_6000):
     """... and with the margin of 0.85, as a user choosing ``target_points``
     expects (the general sampler's promise); cutcube at 6,000 does not."""
-    r, rep = cutcube_6000
+    rep = cutcube_6000
     assert rep.worst_ratio.max() <= 0.85
 
 

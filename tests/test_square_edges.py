@@ -234,9 +234,8 @@ def test_a_chamfer_two_h_wide_slanted_to_the_rows_is_scanned_along_its_edges():
     assert strips == 4
     # a strip wider than three spacings, or narrower than two clearances, keeps its family
     ef = EdgeFaces(s.solid)
-    lines, by_face = ef.straight(1e-9)
     for h_try in (width / 3.2, width / 1.3):
-        same, fam, held = _strip_rows(ef, lines, by_face, np.eye(3), [0] * len(faces), h_try)
+        same, fam, held = _strip_rows(ef, np.eye(3), [0] * len(faces), h_try, 1e-9)
         assert same.shape == (3, 3) and fam == [0] * len(faces) and not held
     w = sample_conditions(r.points, s.truth_vertices, s.truth_triangles).worst_ratio
     bad = r.points[w >= np.sqrt(3) / 2]
