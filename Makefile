@@ -66,15 +66,18 @@ lock: $(STAMP)
 # a survey of the generated models (no shrinking, failures listed with their
 # recipes, every class's shares): make fuzz FUZZ=tests/test_generated.py
 # FUZZ_SURVEY=1 GENERATED_PER_CLASS=4; FUZZ_SEED=N draws the same models
-# again (a survey before and after a change, on the same models)
+# again (a survey before and after a change, on the same models);
+# FUZZ_JOBS=2 spreads the tests over two processes (pytest-xdist)
 FUZZ ?= tests/test_fuzz.py tests/test_properties.py tests/test_generated.py
 FUZZ_SURVEY ?= 0
 GENERATED_PER_CLASS ?= 125
 FUZZ_SEED ?=
+FUZZ_JOBS ?=
 fuzz: $(STAMP)
 	HYPOTHESIS_PROFILE=deep FUZZ_REPORT=1 FUZZ_SURVEY=$(FUZZ_SURVEY) \
 	GENERATED_PER_CLASS=$(GENERATED_PER_CLASS) \
 	$(BIN)/python -m pytest -q -p no:cacheprovider \
+	$(if $(FUZZ_JOBS),-n $(FUZZ_JOBS) --dist load) \
 	$(if $(FUZZ_SEED),--hypothesis-seed=$(FUZZ_SEED)) $(FUZZ)
 
 # the optional comparison (Open3D ball pivoting and Poisson, CGAL advancing

@@ -2,6 +2,8 @@
 
 import os
 
+import pytest
+
 # every reconstruction in the suite runs the expensive self-checks
 os.environ["SR33_STRICT"] = "1"
 
@@ -22,7 +24,22 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 _REPORT: dict[str, list[float]] = {}
 
 
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """Hand the examples a test counted to its report (``tests.fuzzstats``),
+    so that they reach the report from pytest-xdist's workers too."""
+    outcome = yield
+    if call.when == "call":
+        from tests import fuzzstats
+
+        outcome.get_result().user_properties.append((fuzzstats.KEY, fuzzstats.taken()))
+
+
 def pytest_runtest_logreport(report):
+    if report.when == "call":
+        from tests import fuzzstats
+
+        fuzzstats.merge(report.user_properties)
     if report.when != "call" or not any(
         f in report.nodeid for f in ("test_properties.py", "test_fuzz.py", "test_generated.py")
     ):
@@ -36,7 +53,7 @@ def pytest_runtest_logreport(report):
 def pytest_terminal_summary(terminalreporter):
     if not os.environ.get("FUZZ_REPORT") or not _REPORT:
         return
-    from tests.fuzzstats import EXAMPLES
+    from tests.fuzzstats import TOTAL_EXAMPLES as EXAMPLES
 
     tr = terminalreporter
     tr.write_line("")
@@ -73,7 +90,8 @@ def _generated_report(tr) -> None:
     samplings that break only Condition II-i (a survey reconstructs them too)
     how many came out homeomorphic; then why the others did not conform
     (issue 24's report)."""
-    from tests.fuzzstats import EXAMPLES, REJECTED
+    from tests.fuzzstats import TOTAL_EXAMPLES as EXAMPLES
+    from tests.fuzzstats import TOTAL_REJECTED as REJECTED
 
     tag = "generated model ("
     classes = [k[len(tag) : -1] for k in EXAMPLES if k.startswith(tag)]
