@@ -233,26 +233,58 @@ def _inside(c, kind, raster, raster_cell, sector, far):
 @njit(cache=True)
 def _rim_clamped(q, rim, inside):
     """``q`` kept in the face and off its rims (``chart.RimClamp``):
-    ``rim`` = (points, inward normals, gaps); a point nearer its nearest
-    rim point than that point's gap, or outside (``inside``), goes to the
-    nearest rim point's inward normal at the gap.  The nearest rim point
-    by all of them, the first of equally near ones."""
-    c, inward, gap = rim
+    ``rim`` = (points, inward normals, gaps, and their ``chart.Buckets``'
+    lo, cell, dims, start, members); a point nearer its nearest rim point
+    than that point's gap, or outside (``inside``), goes to the nearest rim
+    point's inward normal at the gap.  The nearest rim point by all of
+    them, the first of equally near ones (:func:`_nearest`)."""
+    c, inward, gap, lo, cell, dims, start, members = rim
     out = q.copy()
     for k in range(q.shape[0]):
-        best, j = np.inf, -1
-        for m in range(c.shape[0]):
-            dx = q[k, 0] - c[m, 0]
-            dy = q[k, 1] - c[m, 1]
-            d = dx * dx + dy * dy
-            if d < best:
-                best, j = d, m
+        j, best = _nearest(q[k, 0], q[k, 1], c, lo, cell, dims, start, members)
         if j < 0:
             continue
         if np.sqrt(best) < gap[j] or not inside[k]:
             out[k, 0] = c[j, 0] + gap[j] * inward[j, 0]
             out[k, 1] = c[j, 1] + gap[j] * inward[j, 1]
     return out
+
+
+@njit(cache=True)
+def _nearest(x, y, c, lo, cell, dims, start, members):
+    """The point of ``c`` nearest (x, y) and its squared distance: the one a
+    scan of all of them finds (the same squared distances, the first of
+    equally near ones; -1 for a point that is not finite), looked up in the
+    buckets ``lo, cell, dims, start, members`` (``chart.Buckets``) ring by
+    ring of cells round the point's own, until the rings left are all
+    farther (by half a cell more, against rounding) than the nearest found."""
+    best, j = np.inf, -1
+    if not (np.isfinite(x) and np.isfinite(y)) or c.shape[0] == 0:
+        return j, best
+    nx, ny = dims[0], dims[1]
+    # a point off the grid counts from the cell just off it: every cell is
+    # then on one side of it, and the rings' bound still holds
+    ci = int(min(max(np.floor((x - lo[0]) / cell), -1.0), float(nx)))
+    cj = int(min(max(np.floor((y - lo[1]) / cell), -1.0), float(ny)))
+    last = max(ci + 1, nx - ci, cj + 1, ny - cj)
+    for r in range(last + 1):
+        for i in range(max(0, ci - r), min(nx - 1, ci + r) + 1):
+            edge = i == ci - r or i == ci + r
+            jj = cj - r
+            while jj <= cj + r:
+                if 0 <= jj < ny:
+                    cellid = i * ny + jj
+                    for t in range(start[cellid], start[cellid + 1]):
+                        m = members[t]
+                        dx = x - c[m, 0]
+                        dy = y - c[m, 1]
+                        d = dx * dx + dy * dy
+                        if d < best or (d == best and m < j):
+                            best, j = d, m
+                jj = jj + 1 if edge else (jj + 2 * r if r > 0 else jj + 1)
+        if j >= 0 and r >= 1 and best < ((r - 0.5) * cell) ** 2:
+            break
+    return j, best
 
 
 @njit(cache=True)
@@ -348,7 +380,7 @@ def descend(
     ``glue`` = (turn, band, half, middle) of a development whose sides are
     glued (turn 0: none; ``repair._Problem.images`` and ``wrap``).  ``far``
     = (period, beyond) of a raster's inside test (see :func:`_inside`);
-    ``rim_clamp`` = (points, inward normals, gaps)
+    ``rim_clamp`` = (points, inward normals, gaps, and their buckets)
     of the rims a chart's clamp keeps free samples off (kind 3 of
     :func:`_clamped`).
 

@@ -499,6 +499,54 @@ class TriangleRaster:
         return out
 
 
+@dataclass(frozen=True)
+class Buckets:
+    """Points bucketed on a uniform grid, for the repair's descent kernel,
+    which cannot call a k-d tree (``_descent_kernels._nearest``): the grid's
+    corner ``lo``, its ``cell``, its ``dims`` (columns, rows), and per cell
+    (column-major, ``i * rows + j``) its points' indices ascending,
+    ``members[start[k]:start[k + 1]]``."""
+
+    lo: np.ndarray
+    cell: float
+    dims: np.ndarray
+    start: np.ndarray
+    members: np.ndarray
+
+    #: a cell is this many times the median gap between consecutive points
+    #: (a rim's points are in order along it) ...
+    CELL_GAPS = 10.0
+    #: ... grown where the grid would have more than this many cells per point
+    MAX_CELLS_PER_POINT = 16.0
+
+    @classmethod
+    def of(cls, points: np.ndarray) -> Buckets:
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        lo = p.min(axis=0) if p.shape[0] else np.zeros(2)
+        extent = float((p.max(axis=0) - lo).max()) if p.shape[0] else 0.0
+        gaps = np.linalg.norm(np.diff(p, axis=0), axis=1)
+        gaps = gaps[gaps > 0]
+        cell = cls.CELL_GAPS * float(np.median(gaps)) if gaps.size else extent
+        if not (cell > 0.0 and math.isfinite(cell)):
+            cell = 1.0
+        dims = (
+            np.floor((p.max(axis=0) - lo) / cell).astype(np.int64) + 1
+            if p.shape[0]
+            else np.ones(2, np.int64)
+        )
+        cells = float(dims[0]) * float(dims[1])
+        if cells > cls.MAX_CELLS_PER_POINT * max(1, p.shape[0]):
+            cell *= math.sqrt(cells / (cls.MAX_CELLS_PER_POINT * max(1, p.shape[0])))
+            dims = np.floor((p.max(axis=0) - lo) / cell).astype(np.int64) + 1
+        ij = np.minimum(np.floor((p - lo) / cell).astype(np.int64), dims - 1)
+        key = ij[:, 0] * dims[1] + ij[:, 1]
+        members = np.argsort(key, kind="stable").astype(np.int64)
+        start = np.searchsorted(key[members], np.arange(int(dims[0] * dims[1]) + 1)).astype(
+            np.int64
+        )
+        return cls(lo.astype(np.float64), float(cell), dims.astype(np.int64), start, members)
+
+
 class RimClamp:
     """A chart's clamp (:meth:`sr33.samplers.outlines.Rims.clamp`): rim
     points ``c`` (in a k-d ``tree``) with the directions ``inward`` into
@@ -507,11 +555,13 @@ class RimClamp:
     outside the face (``inside``), goes to that rim point's inward normal
     at that distance.  ``gap`` per rim point, ``c`` and ``inward`` are what
     the repair's descent kernel clamps by
-    (``_descent_kernels._rim_clamped``)."""
+    (``_descent_kernels._rim_clamped``), finding the nearest rim point in
+    ``buckets`` (:class:`Buckets`)."""
 
     def __init__(self, c, inward, scale, tree: cKDTree, inside, margin: float):
         self.c, self.inward, self.tree, self.inside = c, inward, tree, inside
         self.gap = margin * scale
+        self.buckets = Buckets.of(c)
 
     def __call__(self, p: np.ndarray) -> np.ndarray:
         d, j = self.tree.query(p)

@@ -384,3 +384,46 @@ def test_a_chain_of_flat_hull_triangles_is_peeled_whole():
     assert (np.abs(_doubled_areas(pts, tri)) > 1e-9).all()
     np.testing.assert_array_equal(nbr, neighbours_of(tri))  # renumbered
     assert delaunay_flips(pts, tri, nbr, 1e-9, 1e-10) is not None
+
+
+def _nearest_by_all(q, c):
+    """The nearest point of ``c`` to each of ``q`` as a scan of all finds it
+    (the first of equally near ones), and its squared distance."""
+    d = ((q[:, None, :] - c[None, :, :]) ** 2).sum(axis=2)
+    j = np.argmin(d, axis=1)  # the first of the smallest
+    return j, d[np.arange(q.shape[0]), j]
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    n=st.integers(1, 400),
+    lattice=st.booleans(),
+    far=st.floats(0.0, 50.0),
+)
+def test_the_rim_buckets_find_the_point_a_scan_of_all_finds(seed, n, lattice, far):
+    """``_descent_kernels._nearest`` (the rim clamp's lookup in
+    ``chart.Buckets``) returns the index and squared distance a scan of
+    every rim point returns, ties to the first: on a wavy rim in order along
+    it, on a lattice of rim points (equally near ones, repeated points),
+    for queries on the grid, off it by up to ``far`` and not finite."""
+    from sr33.samplers._descent_kernels import _nearest
+    from sr33.samplers.chart import Buckets
+
+    rng = np.random.default_rng(seed)
+    t = np.sort(rng.uniform(0.0, 2 * np.pi, n))
+    c = np.stack([np.cos(t), 0.6 * np.sin(t) + 0.1 * np.sin(7 * t)], axis=1)
+    if lattice:  # the rim's points on a lattice of 1/8: repeated points
+        c = np.round(c * 8.0) / 8.0
+    b = Buckets.of(c)
+    assert b.start[-1] == n and sorted(b.members.tolist()) == list(range(n))
+    lo, hi = c.min(axis=0), c.max(axis=0)
+    q = rng.uniform(lo - 0.2 - far, hi + 0.2 + far, (200, 2))
+    if lattice:  # on a lattice of 1/16: several rim points equally near
+        q[:100] = rng.integers(-20, 20, (100, 2)) / 16.0
+    want_j, want_d = _nearest_by_all(q, c)
+    got = [_nearest(x, y, c, b.lo, b.cell, b.dims, b.start, b.members) for x, y in q]
+    assert [j for j, _ in got] == want_j.tolist()
+    assert [d for _, d in got] == want_d.tolist()  # the same floats, bit for bit
+    for x, y in ((np.nan, 0.0), (0.0, np.inf)):
+        assert _nearest(x, y, c, b.lo, b.cell, b.dims, b.start, b.members)[0] == -1
