@@ -212,6 +212,12 @@ def _box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     )
 
 
+def _faces_of(reports: list[dict]) -> set[int]:
+    """The faces the layouts' and repairs' ``reports`` name (``faces`` or ``face``)."""
+    took = [f for x in reports for f in x.get("faces", [x.get("face")])]
+    return {int(f) for f in took if f is not None}
+
+
 def _distinct(points: np.ndarray, on_feature: np.ndarray, radius: float) -> np.ndarray:
     """Indices (sorted) of the samples kept when no two may be closer than
     ``radius`` (the sampler's contract: h/4): :func:`~.faces.thin` over the
@@ -1502,7 +1508,9 @@ def scan(
             face_id = np.r_[face_id, [nearest_face(q, faces) for q in fill]].astype(np.int64)
             on_feature = np.r_[on_feature, np.zeros(fill.shape[0], dtype=bool)]
         reports: list[dict] = []
+        scan_rows_only: list[dict] | None = None
         if repair:
+            handled: set[int] = set()
             from .bands import lattice_developable_bands
             from .disks import lattice_disk_faces
             from .fillets import lattice_filleted_box
@@ -1525,6 +1533,7 @@ def scan(
                 reports += lattice_revolved_body(occ, bag, h, size, turned=True)
             if reports:
                 pbar.update(11)  # the steps skipped
+                handled = _faces_of(reports)
             else:
                 laid: set[int] = set()  # faces laid out whole: no boundary-layer repair
                 for step, layout in (
@@ -1574,10 +1583,24 @@ def scan(
                     pbar.update(1)
                 with timed("sample: curved faces in their charts"):
                     # what no layout took: rims of any curve, seams (a boolean's pieces)
-                    took = [f for x in reports for f in x.get("faces", [x.get("face")])]
-                    handled = laid | {int(f) for f in took if f is not None}
+                    handled = laid | _faces_of(reports)
                     reports += repair_curved_faces(occ, bag, h, size, skip=handled)
                 pbar.update(1)
+                handled = laid | _faces_of(reports)
+            # curved faces no layout nor repair took keep their scan rows,
+            # which do not aim at Condition III (a torus cut by a boolean)
+            scan_rows_only = [
+                {"face": fi, "kind": f.geomType().lower()}
+                for fi, f in enumerate(occ.Faces())
+                if f.geomType() != "PLANE" and fi not in handled
+            ]
+            for left in scan_rows_only:
+                log.warning(
+                    "sample: face %d (%s) keeps its scan rows: no layout or chart takes it, "
+                    "so its samples may break Condition III",
+                    left["face"],
+                    left["kind"],
+                )
             points, line_id, face_id, on_feature = (
                 bag.points,
                 bag.line_id,
@@ -1614,6 +1637,7 @@ def scan(
             "sharp_degrees": float(sharp_degrees),
             "points": int(points.shape[0]),
             "repairs": reports,
+            "scan_rows_only": scan_rows_only,
             "feature_points": int(on_feature.sum()),
             "lines": int(line),
             "area": area,

@@ -242,6 +242,15 @@ def _cmd_sample(args) -> int:
             f"components {exp.components}, Euler {exp.euler}, genus {exp.genus}, "
             f"boundary loops {exp.boundary_loops}",
         ),
+        (
+            "scan rows only",
+            ", ".join(f"face {x['face']} ({x['kind']})" for x in res.meta["scan_rows_only"])
+            + " (no layout or chart takes them: Condition III not aimed at there)"
+            if res.meta.get("scan_rows_only")
+            else "none"
+            if res.meta.get("scan_rows_only") is not None
+            else "all (--no-repair)",
+        ),
         ("output", str(args.output)),
     ]
     print(_table(rows))

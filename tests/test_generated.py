@@ -122,6 +122,10 @@ def test_conforming_samplings_of_generated_models_reconstruct_homeomorphic(featu
             raise
         fuzzstats.reject(f"generated model ({feature}) CHECK FAILED: {model.recipe}: {err}")
         return
+    if why is not None and r.meta["scan_rows_only"]:
+        # the sampler's gap: curved faces no layout or chart takes
+        kinds = sorted({x["kind"] for x in r.meta["scan_rows_only"]})
+        why += f"; left on scan rows: {', '.join(kinds)}"
     if why is not None:
         # not the theorem's input: counted with its reason, not a counterexample
         # a survey names the model too, so that a class's failing kinds can be rebuilt

@@ -1,6 +1,7 @@
 """sr33 sample: listing, sampling with truth and metadata, errors."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -240,3 +241,28 @@ def test_bad_cad_files_are_one_line_errors(tmp_path, capfd, case, message):
     assert len(err) == 1 and message in err[0], err
     assert "StepFile" not in captured.out  # OpenCascade's own report is silenced
     assert not (tmp_path / "p.ply").exists()
+
+
+def test_a_curved_face_no_layout_takes_is_named(tmp_path, capsys, caplog):
+    """A torus cut by a box: its face, trimmed, is a body of revolution no
+    more and no chart takes it, so it keeps its scan rows; the sampling
+    says so (the meta's ``scan_rows_only``, a warning, the summary's row),
+    and a cylinder, its curved face laid out, says none."""
+    import cadquery as cq
+
+    torus = cq.Solid.makeTorus(0.5, 0.15)
+    cut = torus.cut(cq.Solid.makeBox(1.0, 1.0, 1.0, pnt=cq.Vector(-0.2, -0.5, 0.05)))
+    brep = tmp_path / "bitten.brep"
+    cq.Solid(cut.Solids()[0].wrapped).exportBrep(str(brep))
+    meta = tmp_path / "m.json"
+    argv = ["sample", str(brep), "--points", "400", "-o", str(tmp_path / "p.ply")]
+    with caplog.at_level("WARNING", logger="sr33"):
+        assert main(argv + ["--meta", str(meta), "--quiet"]) == 0
+    left = json.loads(meta.read_text())["scan_rows_only"]
+    kinds = [f.geomType() for f in cq.Shape.importBrep(str(brep)).Faces()]
+    assert left == [{"face": kinds.index("TORUS"), "kind": "torus"}]
+    out = capsys.readouterr().out
+    assert re.search(r"^scan rows only +face \d+ \(torus\) \(no layout", out, re.M), out
+    assert any("keeps its scan rows" in r.getMessage() for r in caplog.records)
+    assert main(["sample", "cylinder", "--spacing", "0.15", "-o", str(tmp_path / "c.ply")]) == 0
+    assert re.search(r"^scan rows only +none$", capsys.readouterr().out, re.M)
