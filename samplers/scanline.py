@@ -1510,7 +1510,6 @@ def scan(
         reports: list[dict] = []
         scan_rows_only: list[dict] | None = None
         if repair:
-            handled: set[int] = set()
             from .bands import lattice_developable_bands
             from .disks import lattice_disk_faces
             from .fillets import lattice_filleted_box

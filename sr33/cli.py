@@ -242,19 +242,22 @@ def _cmd_sample(args) -> int:
             f"components {exp.components}, Euler {exp.euler}, genus {exp.genus}, "
             f"boundary loops {exp.boundary_loops}",
         ),
-        (
-            "scan rows only",
-            ", ".join(f"face {x['face']} ({x['kind']})" for x in res.meta["scan_rows_only"])
-            + " (no layout or chart takes them: Condition III not aimed at there)"
-            if res.meta.get("scan_rows_only")
-            else "none"
-            if res.meta.get("scan_rows_only") is not None
-            else "all (--no-repair)",
-        ),
+        ("scan rows only", _scan_rows_only(res.meta.get("scan_rows_only"))),
         ("output", str(args.output)),
     ]
     print(_table(rows))
     return 0
+
+
+def _scan_rows_only(left: list[dict] | None) -> str:
+    """The sampling's curved faces that kept their scan rows (a sampling's
+    ``meta["scan_rows_only"]``; None: every face, ``--no-repair``)."""
+    if left is None:
+        return "all (--no-repair)"
+    if not left:
+        return "none"
+    faces = ", ".join(f"face {x['face']} ({x['kind']})" for x in left)
+    return f"{faces} (no layout or chart takes them: Condition III not aimed at there)"
 
 
 def _cmd_validate(args) -> int:
