@@ -8,7 +8,7 @@ BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed
 DATA    ?= ../shared/datasets
 
-.PHONY: install demo demo-paper test check bench bench-compare lint fuzz lock clean
+.PHONY: install demo demo-paper test check bench bench-compare lint fuzz fuzz-merge lock clean
 
 install: $(STAMP)
 
@@ -67,18 +67,26 @@ lock: $(STAMP)
 # recipes, every class's shares): make fuzz FUZZ=tests/test_generated.py
 # FUZZ_SURVEY=1 GENERATED_PER_CLASS=4; FUZZ_SEED=N draws the same models
 # again (a survey before and after a change, on the same models);
-# FUZZ_JOBS=2 spreads the tests over two processes (pytest-xdist)
+# FUZZ_JOBS=2 spreads the tests over two processes (pytest-xdist);
+# FUZZ_OUT=run.json saves the run's report, and make fuzz-merge
+# FUZZ_REPORTS="a.json b.json" prints saved runs (other seeds) as one report
 FUZZ ?= tests/test_fuzz.py tests/test_properties.py tests/test_generated.py
 FUZZ_SURVEY ?= 0
 GENERATED_PER_CLASS ?= 125
 FUZZ_SEED ?=
 FUZZ_JOBS ?=
+FUZZ_OUT ?=
 fuzz: $(STAMP)
 	HYPOTHESIS_PROFILE=deep FUZZ_REPORT=1 FUZZ_SURVEY=$(FUZZ_SURVEY) \
+	FUZZ_REPORT_JSON=$(FUZZ_OUT) \
 	GENERATED_PER_CLASS=$(GENERATED_PER_CLASS) \
 	$(BIN)/python -m pytest -q -p no:cacheprovider \
 	$(if $(FUZZ_JOBS),-n $(FUZZ_JOBS) --dist load) \
 	$(if $(FUZZ_SEED),--hypothesis-seed=$(FUZZ_SEED)) $(FUZZ)
+
+FUZZ_REPORTS ?=
+fuzz-merge: $(STAMP)
+	$(BIN)/python -m tests.fuzzstats $(FUZZ_REPORTS)
 
 # the optional comparison (Open3D ball pivoting and Poisson, CGAL advancing
 # front); Open3D's wheel needs the system library libusb-1.0

@@ -53,72 +53,12 @@ def pytest_runtest_logreport(report):
 def pytest_terminal_summary(terminalreporter):
     if not os.environ.get("FUZZ_REPORT") or not _REPORT:
         return
-    from tests.fuzzstats import TOTAL_EXAMPLES as EXAMPLES
+    from tests import fuzzstats
 
     tr = terminalreporter
-    tr.write_line("")
-    tr.write_line(f"{'property':<72}{'examples':>9}{'failed':>8}{'seconds':>9}")
-    total = 0
-    for name, (failed, secs) in _REPORT.items():
-        base = name.split("[")[0].replace("test_", "", 1)
-        key = name.split("[")[1].rstrip("]") if "[" in name else ""
-        ex = EXAMPLES.get(f"generated model ({key})") if "generated" in base else None
-        ex = (
-            ex
-            or EXAMPLES.get(name.replace("test_", "", 1))
-            or EXAMPLES.get(
-                f"homeomorphism[{key}]"
-                if "homeomorphism" in base or "sharp" in base
-                else {
-                    "theorem_1_2_rng_equals_urquhart_on_smooth_patches": "theorem_1_2",
-                    "invariance_under_permutation_motion_and_scaling": "invariance",
-                    "robustness_result_or_documented_error": "robustness",
-                    "validator_soundness_planted_defects": "validator_soundness",
-                }.get(base, base),
-                0,
-            )
-        )
-        tr.write_line(f"{name:<72}{ex:>9}{'yes' if failed else '-':>8}{secs:>9.1f}")
-        total += ex
-    tr.write_line(f"{'all properties':<72}{total:>9}")
-    _generated_report(tr)
-
-
-def _generated_report(tr) -> None:
-    """Per feature class of the generated models: drawn, conforming (share),
-    homeomorphic (share of the conforming), failed, seconds, and of the
-    samplings that break only Condition II-i (a survey reconstructs them too)
-    how many came out homeomorphic; then why the others did not conform
-    (issue 24's report)."""
-    from tests.fuzzstats import TOTAL_EXAMPLES as EXAMPLES
-    from tests.fuzzstats import TOTAL_REJECTED as REJECTED
-
-    tag = "generated model ("
-    classes = [k[len(tag) : -1] for k in EXAMPLES if k.startswith(tag)]
-    if not classes:
-        return
-    tr.write_line("")
-    head = f"{'feature class':<18}{'drawn':>7}{'conforming':>12}{'homeomorphic':>14}"
-    tr.write_line(head + f"{'failed':>8}{'seconds':>9}{'beyond II-i':>13}")
-    for c in classes:
-        drawn = EXAMPLES[f"generated model ({c})"]
-        conf = EXAMPLES[f"conforming ({c})"]
-        homeo = EXAMPLES[f"homeomorphic ({c})"]
-        rows = [v for k, v in _REPORT.items() if "generated" in k and k.endswith(f"[{c}]")]
-        failed = sum(r[0] for r in rows)
-        secs = sum(r[1] for r in rows)
-        share = f"{conf} ({100 * conf / drawn:.0f}%)" if drawn else "0"
-        ok = f"{homeo} ({100 * homeo / conf:.0f}%)" if conf else "-"
-        # a survey lists failures and checks that could not judge, not raises
-        crashed = any(k.startswith(f"{tag}{c}) CHECK FAILED") for k in REJECTED)
-        flag = "yes" if failed or homeo < conf or crashed else "-"
-        # III-conforming samplings breaking only II-i (survey): homeomorphic / tried
-        good = EXAMPLES[f"beyond II-i, homeomorphic ({c})"]
-        tried = good + sum(
-            n for k, n in REJECTED.items() if k.startswith(f"beyond II-i, not homeomorphic ({c})")
-        )
-        beyond = f"{good}/{tried}" if tried else "-"
-        tr.write_line(f"{c:<18}{drawn:>7}{share:>12}{ok:>14}{flag:>8}{secs:>9.1f}{beyond:>13}")
-    for reason, n in sorted(REJECTED.items()):
-        if reason.startswith((tag, "beyond II-i")):
-            tr.write_line(f"  {n:>5}  {reason}")
+    for line in fuzzstats.report_lines(_REPORT, fuzzstats.TOTAL_EXAMPLES, fuzzstats.TOTAL_REJECTED):
+        tr.write_line(line)
+    saved = os.environ.get("FUZZ_REPORT_JSON")
+    if saved:
+        fuzzstats.save(saved, _REPORT)
+        tr.write_line(f"report saved to {saved} (merge runs: make fuzz-merge FUZZ_REPORTS=...)")
