@@ -519,25 +519,24 @@ class Buckets:
     #: ... grown where the grid would have more than this many cells per point
     MAX_CELLS_PER_POINT = 16.0
 
+    def table(self) -> tuple:
+        """``(lo, cell, dims, start, members)``, as the kernel takes them."""
+        return (self.lo, self.cell, self.dims, self.start, self.members)
+
     @classmethod
     def of(cls, points: np.ndarray) -> Buckets:
         p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-        lo = p.min(axis=0) if p.shape[0] else np.zeros(2)
-        extent = float((p.max(axis=0) - lo).max()) if p.shape[0] else 0.0
+        lo, hi = (p.min(axis=0), p.max(axis=0)) if p.shape[0] else (np.zeros(2), np.zeros(2))
         gaps = np.linalg.norm(np.diff(p, axis=0), axis=1)
         gaps = gaps[gaps > 0]
-        cell = cls.CELL_GAPS * float(np.median(gaps)) if gaps.size else extent
+        cell = cls.CELL_GAPS * float(np.median(gaps)) if gaps.size else float((hi - lo).max())
         if not (cell > 0.0 and math.isfinite(cell)):
             cell = 1.0
-        dims = (
-            np.floor((p.max(axis=0) - lo) / cell).astype(np.int64) + 1
-            if p.shape[0]
-            else np.ones(2, np.int64)
-        )
-        cells = float(dims[0]) * float(dims[1])
-        if cells > cls.MAX_CELLS_PER_POINT * max(1, p.shape[0]):
-            cell *= math.sqrt(cells / (cls.MAX_CELLS_PER_POINT * max(1, p.shape[0])))
-            dims = np.floor((p.max(axis=0) - lo) / cell).astype(np.int64) + 1
+        dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
+        most = cls.MAX_CELLS_PER_POINT * max(1, p.shape[0])
+        if float(dims[0]) * float(dims[1]) > most:
+            cell *= math.sqrt(float(dims[0]) * float(dims[1]) / most)
+            dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
         ij = np.minimum(np.floor((p - lo) / cell).astype(np.int64), dims - 1)
         key = ij[:, 0] * dims[1] + ij[:, 1]
         members = np.argsort(key, kind="stable").astype(np.int64)

@@ -75,6 +75,7 @@ from ._repair_kernels import (
 from .chart import (
     ArcClamp,
     ArcGhosts,
+    Buckets,
     Chain,
     CurveProjection,
     Joined,
@@ -676,23 +677,10 @@ def _kernel_form(prob: _Problem) -> dict | None:
                 np.ascontiguousarray(rim.c, dtype=np.float64),
                 np.ascontiguousarray(rim.inward, dtype=np.float64),
                 np.ascontiguousarray(rim.gap, dtype=np.float64),
-                rim.buckets.lo,
-                rim.buckets.cell,
-                rim.buckets.dims,
-                rim.buckets.start,
-                rim.buckets.members,
             )
+            + rim.buckets.table()
             if rim is not None
-            else (
-                none2,
-                none2,
-                none,
-                np.zeros(2),
-                1.0,
-                np.ones(2, dtype=np.int64),
-                np.zeros(2, dtype=np.int64),
-                np.empty(0, dtype=np.int64),
-            )
+            else (none2, none2, none) + Buckets.of(none2).table()
         ),
         sector=(
             (float(inside.outer), float(inside.inner), float(inside.theta), bool(inside.full))

@@ -1590,7 +1590,7 @@ def scan(
             # which do not aim at Condition III (a torus cut by a boolean)
             scan_rows_only = [
                 {"face": fi, "kind": f.geomType().lower()}
-                for fi, f in enumerate(occ.Faces())
+                for fi, f in enumerate(faces)
                 if f.geomType() != "PLANE" and fi not in handled
             ]
             for left in scan_rows_only:

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from sr33 import libm
-from sr33.mesh import dot, norm
+from sr33.mesh import dot, flipped_triangles, near_cocircular, norm
 
 from .chart import Arc, Raster, arc_clamp, arc_sides, segment_distance, unfold_across_arc
 from .faces import (
@@ -272,34 +272,15 @@ def sphere_worst(points: np.ndarray, centre: np.ndarray, radius: float, h: float
         hull = ConvexHull(p)
     except QhullError:
         return 0.0
-    tri, nbr = hull.simplices, hull.neighbors
+    tri = hull.simplices
     chord = norm(p[tri] - p[np.roll(tri, 1, axis=1)])
     kept = chord.max(axis=1) < 2.5 * h
     if not kept.any():
         return 0.0
-    # each side shared by two kept facets, once: (a, b) the side, c the
-    # corner facing it in the facet, d the one in its neighbour
-    t, k = np.nonzero(kept[:, None] & kept[nbr] & (nbr > np.arange(tri.shape[0])[:, None]))
-    n = nbr[t, k]
-    c = tri[t, k]
-    a, b = tri[t, (k + 1) % 3], tri[t, (k + 2) % 3]
-    other = tri[n]
-    d = other[(other != a[:, None]) & (other != b[:, None])]
-    chords = [chord[kept]]
-    if d.size == a.size:  # (a degenerate hull could share more than a side)
-        facing = _angle(p[c], p[a], p[b]) + _angle(p[d], p[a], p[b])
-        near = np.abs(facing - math.pi) < COCIRCULAR
-        flipped = np.concatenate([np.stack([a, c, d], axis=1), np.stack([b, c, d], axis=1)])
-        flipped = flipped[np.concatenate([near, near])]
-        chords.append(norm(p[flipped] - p[np.roll(flipped, 1, axis=1)]))
+    # the quads of two kept facets cocircular within COCIRCULAR, with their other diagonal
+    flipped = flipped_triangles(near_cocircular(p, tri[kept], COCIRCULAR))
+    chords = [chord[kept], norm(p[flipped] - p[np.roll(flipped, 1, axis=1)])]
     half = np.minimum(np.concatenate(chords) / (2.0 * radius), 1.0)  # sine of half the arc
     arc = 2.0 * radius * libm.arctan2(half, np.sqrt(1.0 - half * half))
     side = np.sort(arc, axis=1)
     return float((side[:, 1] / side[:, 2]).max())
-
-
-def _angle(at: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """The angle at ``at`` between the directions to ``x`` and ``y`` (rows)."""
-    u, v = x - at, y - at
-    cos = dot(u, v) / (norm(u) * norm(v))
-    return libm.arccos(np.clip(cos, -1.0, 1.0))

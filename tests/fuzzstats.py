@@ -15,9 +15,7 @@ for one sitting is made in parts.
 """
 
 import json
-import os
 import sys
-import tempfile
 from collections import Counter
 
 EXAMPLES: Counter = Counter()
@@ -126,19 +124,13 @@ def report_lines(report: dict, examples: Counter, rejected: Counter) -> list[str
 
 def save(path: str, report: dict) -> None:
     """Write the run's report (``report`` and the totals) to ``path`` as
-    JSON, atomically (a temporary file renamed)."""
+    JSON, atomically (:func:`sr33.io.write_text`)."""
+    from sr33.io import write_text
+
     text = json.dumps(
         {"report": report, "examples": TOTAL_EXAMPLES, "rejected": TOTAL_REJECTED}, indent=1
     )
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as f:
-            f.write(text + "\n")
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    write_text(path, text + "\n")
 
 
 def merged(paths: list[str]) -> tuple[dict, Counter, Counter]:
