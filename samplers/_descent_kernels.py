@@ -55,8 +55,8 @@ def _ghost_points(on, ghost_arcs, ghost_lines, ghost_h, kinds):
     parts = []
     for kind in kinds:
         if kind == 0:
-            ga, gd, gdd, gin, corners = ghost_lines
-            parts.append(ghosts(on, ga, gd, gdd, gin, ghost_h, corners))
+            ga, gd, gdd, gin, corners, own = ghost_lines
+            parts.append(ghosts(on, ga, gd, gdd, gin, ghost_h, corners, own))
         else:
             centre, radius, side = ghost_arcs
             parts.append(ghosts_arcs(on, centre, radius, side, ghost_h))
@@ -375,7 +375,7 @@ def descend(
     :class:`~sr33.samplers.chart.CurveProjection` (kind, a, d, dd, lo,
     centre, radius, start, span, closed, margin); the clamps as
     :func:`_clamped` takes them; the ghosts' arcs (centre, radius, side),
-    straight edges (a, d, dd, inward, corners), h and kinds in order (see
+    straight edges (a, d, dd, inward, corners, own), h and kinds in order (see
     :func:`_ghost_points`); the inside test as :func:`_inside` takes it;
     ``glue`` = (turn, band, half, middle) of a development whose sides are
     glued (turn 0: none; ``repair._Problem.images`` and ``wrap``).  ``far``

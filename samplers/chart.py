@@ -100,7 +100,11 @@ class LineClamp:
 class LineGhosts:
     """The neighbouring faces unfolded across straight edges: ``corners``,
     then the points on each edge moved ``h`` and ``2 h`` outwards
-    (``inward`` (m, 2) unit normals into the face)."""
+    (``inward`` (m, 2) unit normals into the face).  ``own`` (m,) tells
+    what each edge gives (:data:`sr33.samplers._line_kernels.GHOSTS`, or
+    ``OWN_GHOSTS``: only those no other edge is nearer to, or
+    ``NO_GHOSTS``: another edge of the face, there for that test; None:
+    ``GHOSTS`` for all)."""
 
     a: np.ndarray
     d: np.ndarray
@@ -108,10 +112,24 @@ class LineGhosts:
     inward: np.ndarray
     h: float
     corners: np.ndarray
+    own: np.ndarray | None = None
+
+    def ghosting(self) -> np.ndarray:
+        """(m,) int64: what each edge gives (see ``own``)."""
+        if self.own is None:
+            return np.full(self.a.shape[0], line_kernels.GHOSTS, dtype=np.int64)
+        return np.asarray(self.own, dtype=np.int64)
 
     def __call__(self, p: np.ndarray) -> np.ndarray:
         return line_kernels.ghosts(
-            as_points(p), self.a, self.d, self.dd, self.inward, self.h, self.corners
+            as_points(p),
+            self.a,
+            self.d,
+            self.dd,
+            self.inward,
+            self.h,
+            self.corners,
+            self.ghosting(),
         )
 
 

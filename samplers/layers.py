@@ -189,16 +189,37 @@ def _band_arcs(nbrs, to2d, arcs: list[Arc], sides, s: Samples, h: float, unfold)
     return flags, np.vstack(frames)
 
 
-def _line_ghosts(lines: list[_Line], h: float):
+def _line_ghosts(lines: list[_Line], others: list[_Line], h: float, nearest: bool = False):
     """The neighbouring face unfolded across straight edges whose samples
     slide because that face's columns follow them (``follows``): its first
-    two rows, h and 2h beyond each of the edge's samples and corners."""
-    corners = np.vstack(
-        [end - j * h * ln.inward for ln in lines for end in (ln.a, ln.b) for j in (1.0, 2.0)]
-    )
-    edges = _Edges(lines)
-    inward = np.array([ln.inward for ln in lines], dtype=np.float64).reshape(-1, 2)
-    return LineGhosts(edges.a, edges.d, edges.dd, inward, float(h), corners)
+    two rows, h and 2h beyond each of the edge's samples and corners.
+    With ``nearest``, only those no straight edge of the face (these and
+    ``others``) is nearer to than their own: beside a reflex corner the
+    faces across its two edges unfold onto one another, and a ghost of one
+    edge beyond the other is no sample the geodesics see
+    (:func:`sr33.samplers._line_kernels.ghosts`; :func:`_hidden_bad`
+    tells where that matters)."""
+    ends = [
+        (k, end - j * h * ln.inward)
+        for k, ln in enumerate(lines)
+        for end in (ln.a, ln.b)
+        for j in (1.0, 2.0)
+    ]
+    corners = np.array([q for _, q in ends], dtype=np.float64).reshape(-1, 2)
+    if not nearest:
+        edges = _Edges(lines)
+        inward = np.array([ln.inward for ln in lines], dtype=np.float64).reshape(-1, 2)
+        return LineGhosts(edges.a, edges.d, edges.dd, inward, float(h), corners)
+    edges = _Edges(lines + others)
+    which = np.array([k for k, _ in ends], dtype=np.int64)
+    corners = corners[line_kernels.owned(corners, which, edges.a, edges.d, edges.dd, float(h))]
+    inward = np.array(
+        [ln.inward for ln in lines] + [np.zeros(2) for _ in others], dtype=np.float64
+    ).reshape(-1, 2)
+    own = np.r_[
+        np.full(len(lines), line_kernels.OWN_GHOSTS), np.full(len(others), line_kernels.NO_GHOSTS)
+    ].astype(np.int64)
+    return LineGhosts(edges.a, edges.d, edges.dd, inward, float(h), corners, own)
 
 
 def _joined(fns):
@@ -491,6 +512,81 @@ def _congruence(x, h: float) -> bytes:
     return (np.round(np.asarray(x, dtype=np.float64) / h / CONGRUENCE_GRID) + 0.0).tobytes()
 
 
+#: a repaired planar face whose own samples' Delaunay triangles reach this
+#: ratio where its repair judged less has triangles its ghosts hid
+HIDDEN = 0.85
+
+
+def _hidden_bad(face, s: Samples, h: float, claimed: float) -> bool:
+    """Whether the Delaunay triangles of a planar face's own samples (its
+    edges' too), with the samples of the faces across its straight edges
+    unfolded into its plane as its neighbours' (each kept where its own
+    edge is the face's nearest), include one inside the face at or above
+    ``HIDDEN`` and above the worst its repair ``claimed``: a ghost beyond
+    a reflex corner hid it (a star prism over 12 corners, its caps judged
+    0.830, had 7 triangles up to 0.975 at its reflex corners)."""
+    o, u, v, n = _plane_frame(face)
+
+    def to2d(p):
+        q = np.asarray(p, dtype=np.float64) - o
+        return np.stack([dot(q, u), dot(q, v)], axis=1)
+
+    tol = 1e-6 * h
+    seg = boundary_segments(face, to2d, h / 20)
+    raster = Raster(seg, h / RASTER)
+    cand = np.flatnonzero(np.abs(dot(s.points - o, n)) < tol)
+    uv = to2d(s.points[cand])
+    own = uv[raster(uv) | (segment_distance(uv, seg, h / 100) < 0.1 * h)]
+    if own.shape[0] < 3:
+        return False
+    lines = []
+    for e in face.Edges():
+        if e.geomType() != "LINE":
+            continue
+        a3, b3 = (np.array(q.toTuple()) for q in (e.startPoint(), e.endPoint()))
+        lines.append((a3, b3))
+    if not lines:
+        return False
+    a2 = to2d(np.array([a for a, _ in lines]))
+    d2 = to2d(np.array([b for _, b in lines])) - a2
+    dd = dot(d2, d2)
+    frame = []
+    for k, (a3, b3) in enumerate(lines):
+        length = float(norm(b3 - a3))
+        w = (b3 - a3) / length
+        t = dot(s.points - a3, w)
+        foot = a3 + t[:, None] * w
+        dist = np.linalg.norm(s.points - foot, axis=1)
+        across = (
+            (t > 0)
+            & (t < length)
+            & (dist < LAYER * h)
+            & (dist > tol)
+            & (np.abs(dot(s.points - o, n)) > tol)
+        )
+        if not across.any():
+            continue
+        m3 = np.cross(n, w)
+        m2 = to2d((a3 + m3)[None])[0] - to2d(a3[None])[0]
+        mid = to2d(((a3 + b3) / 2)[None])[0]
+        side = -1.0 if raster((mid + 0.5 * h * m2)[None])[0] else 1.0
+        q = to2d(foot[across] + side * dist[across, None] * m3)
+        near = line_kernels.distance(q, a2, d2, dd)
+        frame.append(q[near.argmin(axis=1) == k])
+    pts = np.vstack([own] + frame)
+    try:
+        tri = Delaunay(pts).simplices
+    except Exception:  # degenerate (collinear) input: nothing to judge
+        return False
+    tri = tri[(tri < own.shape[0]).all(axis=1)]
+    e = np.linalg.norm(pts[tri] - pts[np.roll(tri, 1, axis=1)], axis=2)
+    tri = tri[(e.max(axis=1) < 2.0 * h) & raster(pts[tri].mean(axis=1))]
+    if tri.size == 0:
+        return False
+    worst = float(triangle_ratios(pts, tri).max())
+    return worst >= HIDDEN and worst > claimed + 1e-6
+
+
 def repair_planar_faces(
     occ,
     s: Samples,
@@ -503,6 +599,7 @@ def repair_planar_faces(
     squares: bool = False,
     unfold=frozenset(),
     last: dict[int, tuple[float, int]] | None = None,
+    nearest=frozenset(),
 ) -> list[dict]:
     """Repair the boundary layer of every planar face bounded by circular arcs
     or by straight sharp edges slanted to its scan rows.
@@ -572,6 +669,7 @@ def repair_planar_faces(
     reports = []
     done: dict[tuple, object] = {}
     further = last is not None
+    line_ghosted: set[int] = set()  # faces whose repair had ghosts across straight edges
     # a full cylinder's first rim laid: its samples (3-D); a face repaired
     # again gets the rims laid in the first round
     walls = {} if walls is None else walls
@@ -640,6 +738,8 @@ def repair_planar_faces(
         # those on a straight edge along the other face's rows, whose columns
         # follow them afterwards (that face's rows stand beyond it as ghosts)
         follow = [ln for ln in lines if ln.follows]
+        if follow:
+            line_ghosted.add(fi)
         sliding = [c for c in arcs if c.slides] + [ln for ln in lines if ln.slides or ln.follows]
         near_sliding = np.min(np.stack([far] + [c.distance(uv) for c in sliding], axis=1), axis=1)
         slide = feat & (near_sliding < tol) & ~at_corner
@@ -710,7 +810,18 @@ def repair_planar_faces(
                         if (ghosted := [a for a, b in zip(arcs, banded) if not b])
                         else []
                     )
-                    + ([_line_ghosts(follow, h)] if follow else [])
+                    + (
+                        [
+                            _line_ghosts(
+                                follow,
+                                [ln for ln in lines if not ln.follows] + walls_in,
+                                h,
+                                nearest=fi in nearest,
+                            )
+                        ]
+                        if follow
+                        else []
+                    )
                 ),
                 anchors=anchors if anchors.any() else None,
                 clamp=Chain(tuple(clamps)),
@@ -787,9 +898,40 @@ def repair_planar_faces(
                 squares=squares,
                 unfold=unfold,
                 last=figures,
+                nearest=nearest,
             )
         }
         reports = [redone.get(x["face"], x) for x in reports]
+    if last is None:
+        # faces whose ghosts beyond a reflex corner hid bad triangles from
+        # their repair: repaired again, the ghosts of each edge kept where
+        # it is the nearest
+        hidden = {
+            x["face"]
+            for x in reports
+            if x["face"] in line_ghosted
+            and x["face"] not in nearest
+            and _hidden_bad(faces[x["face"]], s, h, x["worst"])
+        }
+        if hidden:
+            log.debug("planar faces with hidden bad triangles: %s", sorted(hidden))
+            redone = {
+                x["face"]: x
+                for x in repair_planar_faces(
+                    occ,
+                    s,
+                    h,
+                    size,
+                    row_dirs,
+                    set(range(len(faces))) - hidden,
+                    again=again,
+                    walls=walls,
+                    squares=squares,
+                    unfold=unfold,
+                    nearest=frozenset(nearest | hidden),
+                )
+            }
+            reports = [redone.get(x["face"], x) for x in reports]
     return reports
 
 

@@ -656,9 +656,16 @@ def _kernel_form(prob: _Problem) -> dict | None:
             else (none2, none, none)
         ),
         ghost_lines=(
-            (line_ghosts.a, line_ghosts.d, line_ghosts.dd, line_ghosts.inward, line_ghosts.corners)
+            (
+                line_ghosts.a,
+                line_ghosts.d,
+                line_ghosts.dd,
+                line_ghosts.inward,
+                line_ghosts.corners,
+                line_ghosts.ghosting(),
+            )
             if line_ghosts is not None
-            else (none2, none2, none, none2, none2)
+            else (none2, none2, none, none2, none2, np.empty(0, dtype=np.int64))
         ),
         ghost_h=float(ghosts[0].h) if ghosts else 0.0,
         ghost_kinds=np.array(

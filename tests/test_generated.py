@@ -372,3 +372,32 @@ def test_regression_a_slender_cone_turned_off_the_axes_closes_round_its_apex(cas
     if why is not None:  # not the counterexample any more: say so
         pytest.fail(f"the regression's sampling does not conform any more: {why}")
     check_homeomorphism(shape, r.points, r.meta["spacing"], reconstruct(r.points, 33))
+
+
+@pytest.mark.slow
+def test_regression_a_star_prism_s_caps_meet_condition_iii_at_their_reflex_corners():
+    """Seed 70's survey (stop 70): a star prism over 12 corners (tips at
+    0.633, notches at 0.415 of that, 0.365 high), turned 17° about z.  Its
+    caps' repair had the ghosts of one side beyond the reflex corner of the
+    next (the faces across a reflex corner's two edges unfold onto one
+    another), which hid 7 triangles of each cap up to 0.975 from it (judged
+    0.830): 40 samples broke III-ii.  The repair now checks each face's own
+    triangles after it and repairs again, with the ghosts of each edge kept
+    where it is the nearest.  (Its 35.8° tips break II-i at any density:
+    the sampling is beyond the guarantee there, by Condition II-i only.)"""
+    import cadquery as cq
+
+    from sr33.samplers import shapes
+
+    a = np.pi * np.arange(12) / 6
+    r = np.where(np.arange(12) % 2 == 0, 0.633307925673659, 0.26249774248149127)
+    corners = [(float(x), float(y)) for x, y in zip(r * np.cos(a), r * np.sin(a))]
+    height = 0.3646623097494604
+    solid = cq.Workplane().polyline(corners).close().extrude(height).val()
+    solid = moved(solid.translate(cq.Vector(0, 0, -height / 2)), (0, 0, 17.0), (0, 1.52, -1.39))
+    shape = shapes.from_cad(solid, name="generated")
+    s = scan(shape, target_points=TARGET_POINTS)
+    rep = sample_conditions(s.points, shape.truth_vertices, shape.truth_triangles)
+    worst = float(rep.worst_ratio.max())
+    assert worst < rep.ratio_limit - 0.01, worst
+    assert conformance(shape, s.points, s.face_id, s.meta["spacing"], ii_i=False) is None

@@ -427,3 +427,67 @@ def test_the_rim_buckets_find_the_point_a_scan_of_all_finds(seed, n, lattice, fa
     assert [d for _, d in got] == want_d.tolist()  # the same floats, bit for bit
     for x, y in ((np.nan, 0.0), (0.0, np.inf)):
         assert _nearest(x, y, c, b.lo, b.cell, b.dims, b.start, b.members)[0] == -1
+
+
+def _star(points: int, inner: float, turn: float) -> np.ndarray:
+    """A star polygon's corners (counter-clockwise): ``points`` tips at
+    radius 1, notches at ``inner`` (reflex corners when small), turned."""
+    a = turn + np.pi * np.arange(2 * points) / points
+    r = np.where(np.arange(2 * points) % 2 == 0, 1.0, inner)
+    return np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+
+
+def _edge_points(corners: np.ndarray, h: float, rng) -> tuple:
+    """The polygon's edges (a, d, dd, unit normals into it) and points on
+    them: the corners and jittered points about h apart."""
+    a = corners
+    d = np.roll(corners, -1, axis=0) - a
+    dd = (d * d).sum(axis=1)
+    inward = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.sqrt(dd)[:, None]
+    on = [a]
+    for k in range(a.shape[0]):
+        m = max(int(np.sqrt(dd[k]) / h), 1)
+        t = (np.arange(1, m) + rng.uniform(-0.3, 0.3, m - 1)) / m
+        on.append(a[k] + t[:, None] * d[k])
+    return a, d, dd, inward, np.vstack(on)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    points=st.integers(3, 8),
+    inner=st.floats(0.3, 0.9),
+    turn=st.floats(0.0, 2 * np.pi),
+    h=st.floats(0.04, 0.12),
+)
+def test_ghosts_beside_a_reflex_corner_keep_to_their_own_edge(seed, points, inner, turn, h):
+    """``_line_kernels.ghosts`` with ``OWN_GHOSTS``: the points on a face's
+    edges moved h and 2h outwards, less those another edge is nearer to
+    (beside a reflex corner the faces across its two edges unfold onto one
+    another).  Every ghost kept lies h or 2h from the nearest edge; they
+    are the plain ghosts in the same order with some left out, none on a
+    convex polygon (where the two agree bit for bit), some on a star whose
+    notches are reflex corners."""
+    from sr33.samplers._line_kernels import GHOSTS, OWN_GHOSTS, distance, ghosts
+
+    rng = np.random.default_rng(seed)
+    convex = inner >= np.cos(np.pi / points)  # the notches' corners are not reflex
+    a, d, dd, inward, on = _edge_points(_star(points, inner, turn), h, rng)
+    none = np.empty((0, 2))
+    m = a.shape[0]
+    plain = ghosts(on, a, d, dd, inward, h, none, np.full(m, GHOSTS, dtype=np.int64))
+    kept = ghosts(on, a, d, dd, inward, h, none, np.full(m, OWN_GHOSTS, dtype=np.int64))
+    nearest = distance(kept, a, d, dd).min(axis=1) / h
+    assert np.all(np.isclose(nearest, 1.0, atol=1e-6) | np.isclose(nearest, 2.0, atol=1e-6))
+    # a subsequence of the plain ghosts
+    j = 0
+    for g in kept:
+        while j < plain.shape[0] and not np.array_equal(plain[j], g):
+            j += 1
+        assert j < plain.shape[0]
+        j += 1
+    if convex:
+        assert np.array_equal(kept, plain)
+    elif inner < 0.8 * np.cos(np.pi / points):  # clearly reflex: ghosts overlap there
+        assert kept.shape[0] < plain.shape[0]
+        assert distance(plain, a, d, dd).min(axis=1).min() < 0.99 * h
