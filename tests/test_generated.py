@@ -93,7 +93,32 @@ def conformance(
         kinds = [faces[int(f)].geomType().lower() for f in face_id[bad] if f >= 0]
         counts = {k: kinds.count(k) for k in sorted(set(kinds))}
         why += " on " + ", ".join(f"{k} ({n} samples)" for k, n in counts.items()) if kinds else ""
+    if why.startswith("II-i"):
+        wedge = sharpest_wedge(shape.truth_vertices, shape.truth_triangles)
+        if wedge < II_I_WEDGE:
+            # the model's, not the sampler's: no density meets II-i along it
+            why += f"; a {wedge:.1f}° wedge (II-i fails at any density below {II_I_WEDGE:.1f}°)"
     return why
+
+
+#: a wedge sharper than this (degrees) breaks Condition II-i along its edge
+#: at any density (:func:`sr33.validators.conditions.neighbourhood_reach`:
+#: 2 arccot REACH)
+II_I_WEDGE = float(np.degrees(2 * np.arctan(1 / REACH)))
+
+
+def sharpest_wedge(vertices, triangles) -> float:
+    """The sharpest wedge of a truth mesh, in degrees: 180 less the largest
+    angle between the normals of two triangles sharing an edge (a convex
+    edge's inside angle, a reflex edge's opening; 180 where none turns)."""
+    from sr33.validators.fidelity import dihedral_pairs
+
+    _, _, _, cos = dihedral_pairs(
+        np.asarray(vertices, dtype=np.float64), np.asarray(triangles, dtype=np.int64)
+    )
+    if cos.size == 0:
+        return 180.0
+    return float(180.0 - np.degrees(np.arccos(np.clip(cos.min(), -1.0, 1.0))))
 
 
 def guarantee(model, points: np.ndarray, spacing: float, rec) -> None:
@@ -152,6 +177,21 @@ def test_conforming_samplings_of_generated_models_reconstruct_homeomorphic(featu
         fuzzstats.reject(f"generated model ({feature}) FAILED: {model.recipe}: {err}")
         return
     fuzzstats.count(f"homeomorphic ({feature})")
+
+
+@pytest.mark.parametrize(
+    "name, lo, hi", [("wedge", 29.0, 31.0), ("cube", 89.0, 91.0), ("star_prism", 40.0, 41.0)]
+)
+def test_the_sharpest_wedge_of_a_library_shape(name, lo, hi):
+    """:func:`sharpest_wedge` reads a shape's sharpest edge off its truth
+    mesh: the library's 30° wedge, the cube's right angles, the star prism's 40.6° tips; a survey's
+    II-i reason names a wedge sharper than :data:`II_I_WEDGE` (36.9°)."""
+    from sr33.samplers import shapes
+
+    shape = shapes.build(name)
+    wedge = sharpest_wedge(shape.truth_vertices, shape.truth_triangles)
+    assert lo < wedge < hi, wedge
+    assert 36.8 < II_I_WEDGE < 36.9
 
 
 def test_the_generated_property_fails_on_a_broken_reconstruction():
