@@ -785,3 +785,40 @@ def test_corner_score_is_the_worst_ratio_of_the_corners_delaunay_triangles():
     assert pen == pytest.approx(0.0, abs=1e-12)
     tight = corner_score(pts, ray, dirs, 4.0, 1.0, 0.75, 1.0, 0.0, 1e9)[1]
     assert tight == pytest.approx(10.0 * 2 * 0.1, abs=1e-9)  # the 1.1 gap on each ray
+
+
+@pytest.mark.parametrize("wide", [1.6, 2.3, 3.4])
+def test_columns_that_followed_apart_get_a_column_between(wide):
+    """``layers._fill_columns``: a side's lattice (rows h apart along the
+    edge, columns 1.2 h apart) whose columns followed an edge's samples,
+    one gap widened to ``wide`` h, gets samples in that gap in every row,
+    evenly, at most GAP[1] h apart; a gap as wide before (across a hole)
+    gets none, nor do the others."""
+    from sr33.samplers.layers import FILL_GAP, _fill_columns
+    from sr33.samplers.repair import GAP
+    from sr33.samplers.samples import Samples
+
+    h = 0.1
+    cols = np.r_[0.0, 1.2, 2.4, 3.6, 7.0, 8.2] * h  # a hole between 3.6 and 7.0
+    before = np.array([(c, w * h, 0.0) for w in range(6) for c in cols])
+    after = before.copy()
+    after[after[:, 0] >= 2.4 * h - 1e-12, 0] += (wide - 1.2) * h  # columns 2.4 on follow apart
+    s = Samples(
+        after.copy(),
+        np.repeat(np.arange(6), len(cols)),
+        np.zeros(len(after), dtype=np.int64),
+        np.zeros(len(after), dtype=bool),
+    )
+    sel = np.arange(len(after))
+    _fill_columns(s, sel, before, np.zeros(3), np.array([1.0, 0.0, 0.0]), 0, h)
+    added = s.points[len(after) :]
+    count = int(math.ceil(wide / GAP[1])) - 1 if wide > FILL_GAP else 0
+    assert added.shape[0] == 6 * count
+    assert np.all(s.face_id == 0) and not s.on_feature.any()
+    for w in range(6):
+        row = np.sort(s.points[np.isclose(s.points[:, 1], w * h), 0])
+        gaps = np.diff(row) / h
+        hole = np.isclose(row[:-1], (3.6 + wide - 1.2) * h)  # the hole's gap stays
+        assert gaps[~hole].max() <= max(GAP[1], 1.2) + 1e-9
+        assert np.isclose(gaps[hole], 3.4).all()
+        assert np.array_equal(s.line_id[len(after) :][np.isclose(added[:, 1], w * h)], [w] * count)
