@@ -246,6 +246,26 @@ def _plane_frame(face):
     return o, u, v, n
 
 
+def _to_plane(o, u, v):
+    """The map of points into the plane frame (o, u, v) of :func:`_plane_frame`."""
+
+    def to2d(p):
+        q = np.asarray(p, dtype=np.float64) - o
+        return np.stack([dot(q, u), dot(q, v)], axis=1)
+
+    return to2d
+
+
+def _face_samples(s: Samples, o, n, to2d, seg, raster, tol: float, h: float):
+    """The samples of a planar face, and their plane coordinates: on its
+    plane (within ``tol``), inside it or on its boundary (``seg``, the
+    tessellation's polyline: arc samples sit a sagitta off it)."""
+    cand = np.flatnonzero(np.abs(dot(s.points - o, n)) < tol)
+    uv = to2d(s.points[cand])
+    mine = raster(uv) | (segment_distance(uv, seg, h / 100) < 0.1 * h)
+    return cand[mine], uv[mine]
+
+
 @dataclass(frozen=True)
 class _Line:
     """A straight sharp edge of a planar face, slanted to the face's rows."""
@@ -526,17 +546,11 @@ def _hidden_bad(face, s: Samples, h: float, claimed: float) -> bool:
     a reflex corner hid it (a star prism over 12 corners, its caps judged
     0.830, had 7 triangles up to 0.975 at its reflex corners)."""
     o, u, v, n = _plane_frame(face)
-
-    def to2d(p):
-        q = np.asarray(p, dtype=np.float64) - o
-        return np.stack([dot(q, u), dot(q, v)], axis=1)
-
+    to2d = _to_plane(o, u, v)
     tol = 1e-6 * h
     seg = boundary_segments(face, to2d, h / 20)
     raster = Raster(seg, h / RASTER)
-    cand = np.flatnonzero(np.abs(dot(s.points - o, n)) < tol)
-    uv = to2d(s.points[cand])
-    own = uv[raster(uv) | (segment_distance(uv, seg, h / 100) < 0.1 * h)]
+    _, own = _face_samples(s, o, n, to2d, seg, raster, tol, h)
     if own.shape[0] < 3:
         return False
     lines = []
@@ -688,11 +702,7 @@ def repair_planar_faces(
         if face.geomType() != "PLANE" or fi in skip:
             continue
         o, u, v, n = _plane_frame(face)
-
-        def to2d(p, o=o, u=u, v=v):
-            q = np.asarray(p, dtype=np.float64) - o
-            return np.stack([dot(q, u), dot(q, v)], axis=1)
-
+        to2d = _to_plane(o, u, v)
         arcs = _arcs(face, to2d, [(e, faces[fb], fb) for e, fb in nbrs[fi] if fb >= 0])
         if not arcs and row_dirs is None:
             continue
@@ -715,14 +725,7 @@ def repair_planar_faces(
         )
         if squares == bool(arcs or any(not ln.square for ln in lines)):
             continue  # repaired in the other pass
-        on_plane = np.abs(dot(s.points - o, n)) < tol
-        cand = np.flatnonzero(on_plane)
-        uv = to2d(s.points[cand])
-        # the face's samples: inside it, or on its boundary (the tessellation's
-        # boundary is a polyline: arc samples sit a sagitta off it)
-        mine = raster(uv) | (segment_distance(uv, seg, h / 100) < 0.1 * h)
-        idx = cand[mine]
-        uv = uv[mine]
+        idx, uv = _face_samples(s, o, n, to2d, seg, raster, tol, h)
         # a fixed order (by position) so that congruent faces get the same answer
         order = np.lexsort((np.round(uv[:, 1] / h, 6), np.round(uv[:, 0] / h, 6)))
         idx, uv = idx[order], uv[order]
