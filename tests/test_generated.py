@@ -179,18 +179,32 @@ def test_conforming_samplings_of_generated_models_reconstruct_homeomorphic(featu
     fuzzstats.count(f"homeomorphic ({feature})")
 
 
-@pytest.mark.parametrize(
-    "name, lo, hi", [("wedge", 29.0, 31.0), ("cube", 89.0, 91.0), ("star_prism", 40.0, 41.0)]
-)
-def test_the_sharpest_wedge_of_a_library_shape(name, lo, hi):
-    """:func:`sharpest_wedge` reads a shape's sharpest edge off its truth
-    mesh: the library's 30° wedge, the cube's right angles, the star prism's 40.6° tips; a survey's
-    II-i reason names a wedge sharper than :data:`II_I_WEDGE` (36.9°)."""
-    from sr33.samplers import shapes
+def _prism_mesh(corners: np.ndarray, height: float):
+    """A closed triangle mesh of a prism over a convex polygon (outward
+    orientation): its sides and two fanned ends."""
+    m = corners.shape[0]
+    v = np.vstack([np.c_[corners, np.zeros(m)], np.c_[corners, np.full(m, height)]])
+    tri = []
+    for i in range(m):
+        j = (i + 1) % m
+        tri += [(i, j, m + j), (i, m + j, m + i)]
+    tri += [(0, k + 1, k) for k in range(1, m - 1)]
+    tri += [(m, m + k, m + k + 1) for k in range(1, m - 1)]
+    return v, np.array(tri, dtype=np.int64)
 
-    shape = shapes.build(name)
-    wedge = sharpest_wedge(shape.truth_vertices, shape.truth_triangles)
-    assert lo < wedge < hi, wedge
+
+@pytest.mark.parametrize("angle", [20.0, 30.0, 60.0, 90.0])
+def test_the_sharpest_wedge_of_a_prism(angle):
+    """:func:`sharpest_wedge` reads a prism's sharpest edge off its mesh:
+    over a triangle with a corner of ``angle`` degrees (and 60 or more at
+    its others), that angle; a survey's II-i reason names a wedge sharper
+    than :data:`II_I_WEDGE` (36.9°)."""
+    a = np.radians(angle)
+    # an isosceles triangle: apex angle a, base angles (180 - a) / 2
+    corners = np.array([[0.0, 0.0], [1.0, -np.tan(a / 2)], [1.0, np.tan(a / 2)]])
+    v, t = _prism_mesh(corners, 0.5)
+    want = min(angle, (180.0 - angle) / 2, 90.0)
+    assert abs(sharpest_wedge(v, t) - want) < 1e-9
     assert 36.8 < II_I_WEDGE < 36.9
 
 
