@@ -121,3 +121,20 @@ def test_a_local_limit_refines_only_where_it_is_shorter():
         np.cross(rv[rt[:, 1]] - rv[rt[:, 0]], rv[rt[:, 2]] - rv[rt[:, 0]]), axis=1
     )
     assert area.sum() / 2 == pytest.approx(0.5, abs=1e-12)
+
+
+@pytest.mark.parametrize("budget", [10_000, 12_000, 60_000])
+def test_a_resolution_beyond_the_triangle_budget_is_refused(budget):
+    """A unit right triangle (area 1/2) refined to edges of 0.01 needs at
+    least 0.5 / (sqrt(3)/4 * 0.01**2) = 11,547 triangles: refused at once
+    below that budget, refused during the splitting when the bound is met
+    but the result is larger, and refined within a budget it fits."""
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    size = refine_to_edge_length(v, [[0, 1, 2]], 0.01, max_triangles=10**8)[1].shape[0]
+    assert 11_547 < size < 60_000
+    if budget < size:
+        with pytest.raises(ValueError, match=r"edges of 0\.01 needs more than \d+ triangles"):
+            refine_to_edge_length(v, [[0, 1, 2]], 0.01, max_triangles=budget)
+    else:
+        rv, rt = refine_to_edge_length(v, [[0, 1, 2]], 0.01, max_triangles=budget)
+        assert rt.shape[0] == size
