@@ -32,17 +32,23 @@ def along(p, a, d, dd):
 
 
 @njit(cache=True)
+def _segment_distance(x, y, a, d, dd, k):
+    """The distance of (x, y) to edge ``k`` (see :func:`along`)."""
+    t = ((x - a[k, 0]) * d[k, 0] + (y - a[k, 1]) * d[k, 1]) / dd[k]
+    t = min(max(t, 0.0), 1.0)
+    qx = x - (a[k, 0] + t * d[k, 0])
+    qy = y - (a[k, 1] + t * d[k, 1])
+    return np.sqrt(qx * qx + qy * qy)
+
+
+@njit(cache=True)
 def distance(p, a, d, dd):
     """(n, m): every point's distance to every edge (see :func:`along`)."""
     n, m = p.shape[0], a.shape[0]
     out = np.empty((n, m))
     for i in range(n):
         for k in range(m):
-            t = ((p[i, 0] - a[k, 0]) * d[k, 0] + (p[i, 1] - a[k, 1]) * d[k, 1]) / dd[k]
-            t = min(max(t, 0.0), 1.0)
-            qx = p[i, 0] - (a[k, 0] + t * d[k, 0])
-            qy = p[i, 1] - (a[k, 1] + t * d[k, 1])
-            out[i, k] = np.sqrt(qx * qx + qy * qy)
+            out[i, k] = _segment_distance(p[i, 0], p[i, 1], a, d, dd, k)
     return out
 
 
@@ -85,15 +91,9 @@ OWN_SLACK = 1e-9
 @njit(cache=True)
 def _own_nearest(x, y, k, a, d, dd, slack):
     """Whether no edge is nearer to (x, y) than edge ``k`` by more than ``slack``."""
-    dist = np.empty(a.shape[0])
+    bound = _segment_distance(x, y, a, d, dd, k) - slack
     for q in range(a.shape[0]):
-        t = ((x - a[q, 0]) * d[q, 0] + (y - a[q, 1]) * d[q, 1]) / dd[q]
-        t = min(max(t, 0.0), 1.0)
-        qx = x - (a[q, 0] + t * d[q, 0])
-        qy = y - (a[q, 1] + t * d[q, 1])
-        dist[q] = np.sqrt(qx * qx + qy * qy)
-    for q in range(a.shape[0]):
-        if q != k and dist[q] < dist[k] - slack:
+        if q != k and _segment_distance(x, y, a, d, dd, q) < bound:
             return False
     return True
 

@@ -199,23 +199,18 @@ def _line_ghosts(lines: list[_Line], others: list[_Line], h: float, nearest: boo
     edge beyond the other is no sample the geodesics see
     (:func:`sr33.samplers._line_kernels.ghosts`; :func:`_hidden_bad`
     tells where that matters)."""
-    ends = [
-        (k, end - j * h * ln.inward)
-        for k, ln in enumerate(lines)
-        for end in (ln.a, ln.b)
-        for j in (1.0, 2.0)
-    ]
-    corners = np.array([q for _, q in ends], dtype=np.float64).reshape(-1, 2)
+    corners = np.array(
+        [end - j * h * ln.inward for ln in lines for end in (ln.a, ln.b) for j in (1.0, 2.0)],
+        dtype=np.float64,
+    ).reshape(-1, 2)
+    inward = np.array([ln.inward for ln in lines], dtype=np.float64).reshape(-1, 2)
     if not nearest:
         edges = _Edges(lines)
-        inward = np.array([ln.inward for ln in lines], dtype=np.float64).reshape(-1, 2)
         return LineGhosts(edges.a, edges.d, edges.dd, inward, float(h), corners)
     edges = _Edges(lines + others)
-    which = np.array([k for k, _ in ends], dtype=np.int64)
+    which = np.repeat(np.arange(len(lines), dtype=np.int64), 4)  # each line's two ends, h and 2h
     corners = corners[line_kernels.owned(corners, which, edges.a, edges.d, edges.dd, float(h))]
-    inward = np.array(
-        [ln.inward for ln in lines] + [np.zeros(2) for _ in others], dtype=np.float64
-    ).reshape(-1, 2)
+    inward = np.vstack([inward, np.zeros((len(others), 2))])
     own = np.r_[
         np.full(len(lines), line_kernels.OWN_GHOSTS), np.full(len(others), line_kernels.NO_GHOSTS)
     ].astype(np.int64)
@@ -564,20 +559,15 @@ def _hidden_bad(face, s: Samples, h: float, claimed: float) -> bool:
     a2 = to2d(np.array([a for a, _ in lines]))
     d2 = to2d(np.array([b for _, b in lines])) - a2
     dd = dot(d2, d2)
+    others = s.points[np.abs(dot(s.points - o, n)) > tol]  # off the face's plane
     frame = []
     for k, (a3, b3) in enumerate(lines):
         length = float(norm(b3 - a3))
         w = (b3 - a3) / length
-        t = dot(s.points - a3, w)
+        t = dot(others - a3, w)
         foot = a3 + t[:, None] * w
-        dist = np.linalg.norm(s.points - foot, axis=1)
-        across = (
-            (t > 0)
-            & (t < length)
-            & (dist < LAYER * h)
-            & (dist > tol)
-            & (np.abs(dot(s.points - o, n)) > tol)
-        )
+        dist = np.linalg.norm(others - foot, axis=1)
+        across = (t > 0) & (t < length) & (dist < LAYER * h) & (dist > tol)
         if not across.any():
             continue
         m3 = np.cross(n, w)
@@ -890,8 +880,11 @@ def repair_planar_faces(
         again,
         ", ".join(f"{x['face']} {x['worst']:.4f} ({x['bad']} bad)" for x in reports),
     )
-    if again > 0 and stuck:
-        rest = set(range(len(faces))) - stuck
+
+    def redo(faces_redone, **kw) -> None:
+        """The faces ``faces_redone`` repaired again (the others skipped),
+        their new reports in place of theirs."""
+        nonlocal reports
         redone = {
             x["face"]: x
             for x in repair_planar_faces(
@@ -900,16 +893,17 @@ def repair_planar_faces(
                 h,
                 size,
                 row_dirs,
-                rest,
-                again=again - 1,
+                set(range(len(faces))) - faces_redone,
                 walls=walls,
                 squares=squares,
                 unfold=unfold,
-                last=figures,
-                nearest=nearest,
+                **kw,
             )
         }
         reports = [redone.get(x["face"], x) for x in reports]
+
+    if again > 0 and stuck:
+        redo(stuck, again=again - 1, last=figures, nearest=nearest)
     if last is None:
         # faces whose ghosts beyond a reflex corner hid bad triangles from
         # their repair: repaired again, the ghosts of each edge kept where
@@ -923,23 +917,7 @@ def repair_planar_faces(
         }
         if hidden:
             log.debug("planar faces with hidden bad triangles: %s", sorted(hidden))
-            redone = {
-                x["face"]: x
-                for x in repair_planar_faces(
-                    occ,
-                    s,
-                    h,
-                    size,
-                    row_dirs,
-                    set(range(len(faces))) - hidden,
-                    again=again,
-                    walls=walls,
-                    squares=squares,
-                    unfold=unfold,
-                    nearest=frozenset(nearest | hidden),
-                )
-            }
-            reports = [redone.get(x["face"], x) for x in reports]
+            redo(hidden, again=again, nearest=frozenset(nearest | hidden))
     return reports
 
 
